@@ -1,0 +1,8 @@
+//! Benchmark scenes of the reference papers with their analytic or
+//! published reference values.
+//!
+//! This crate will hold the cases of Coombs et al. 2020 §7 (compaction under
+//! self weight, simple shear, elastic cantilever, elastic annulus,
+//! elasto-plastic collapse) and of Wang et al. 2021, each as data selected by
+//! name or by a scene file, and the `mpm` command-line program that runs
+//! them. The program arrives with the solver.
