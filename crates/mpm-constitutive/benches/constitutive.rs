@@ -1,0 +1,109 @@
+//! Cost of one material point's constitutive update, with and without each
+//! formulation's consistent tangent.
+//!
+//! Run: `cargo bench -p mpm-constitutive --bench constitutive`. The numbers
+//! are recorded in `docs/src/benchmarks/constitutive.md`.
+#![allow(missing_docs, clippy::unwrap_used)]
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use mpm_constitutive::{
+    ConsistentTangent, HenckyElastic, LogStrainLaw, MaterialState, PreviouslyConvergedTangent,
+    SpatialTangent, SymSpectral, VonMises, VonMisesHistory, update,
+};
+use nalgebra::{Matrix3, Rotation3};
+
+fn inputs() -> (Matrix3<f64>, Matrix3<f64>) {
+    let r = Rotation3::from_euler_angles(0.3, -0.7, 1.1).into_inner();
+    let df = r * Matrix3::new(1.08, 0.05, 0.0, 0.02, 0.95, 0.01, 0.0, -0.03, 1.01);
+    let f_n = Matrix3::new(1.02, 0.1, 0.0, 0.0, 0.97, 0.0, 0.0, 0.0, 1.0);
+    (df, f_n)
+}
+
+fn bench_law<L: LogStrainLaw>(
+    c: &mut Criterion,
+    name: &str,
+    law: &L,
+    state: MaterialState<L::History>,
+) {
+    let (df, f_n) = inputs();
+    let mut g = c.benchmark_group(name);
+    g.bench_function("stress", |b| {
+        b.iter(|| update(law, black_box(&df), black_box(&f_n), black_box(&state)).unwrap())
+    });
+    g.bench_function("stress+pc_tangent", |b| {
+        b.iter(|| {
+            let r = update(law, black_box(&df), black_box(&f_n), black_box(&state)).unwrap();
+            (
+                r.p_tilde(),
+                PreviouslyConvergedTangent::tangent(law, &r).unwrap(),
+            )
+        })
+    });
+    g.bench_function("stress+ul_tangent", |b| {
+        b.iter(|| {
+            let r = update(law, black_box(&df), black_box(&f_n), black_box(&state)).unwrap();
+            (r.sigma, SpatialTangent::tangent(law, &r).unwrap())
+        })
+    });
+    g.finish();
+}
+
+fn constitutive(c: &mut Criterion) {
+    let (df, f_n) = inputs();
+    let be_n = f_n * f_n.transpose();
+    let hencky = HenckyElastic::new(1e6, 0.3).unwrap();
+    bench_law(
+        c,
+        "hencky",
+        &hencky,
+        MaterialState {
+            be: be_n,
+            history: (),
+        },
+    );
+    let elastic_vm = VonMises::new(1e6, 0.3, 1e9, 0.0).unwrap();
+    bench_law(
+        c,
+        "von_mises_elastic_step",
+        &elastic_vm,
+        MaterialState {
+            be: be_n,
+            history: VonMisesHistory::default(),
+        },
+    );
+    let plastic_vm = VonMises::new(1e6, 0.3, 1e3, 1e4).unwrap();
+    let check = update(
+        &plastic_vm,
+        &df,
+        &f_n,
+        &MaterialState {
+            be: be_n,
+            history: VonMisesHistory::default(),
+        },
+    )
+    .unwrap();
+    assert!(check.yielded(), "the plastic benchmark must yield");
+    bench_law(
+        c,
+        "von_mises_plastic_step",
+        &plastic_vm,
+        MaterialState {
+            be: be_n,
+            history: VonMisesHistory::default(),
+        },
+    );
+
+    let b = df * be_n * df.transpose();
+    let mut g = c.benchmark_group("kinematics");
+    g.bench_function("sym_eigen", |bch| {
+        bch.iter(|| SymSpectral::new(black_box(&b)).unwrap())
+    });
+    let s = SymSpectral::new(&b).unwrap();
+    g.bench_function("dlog", |bch| bch.iter(|| black_box(&s).dlog().unwrap()));
+    g.finish();
+}
+
+criterion_group!(benches, constitutive);
+criterion_main!(benches);

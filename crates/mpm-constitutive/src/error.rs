@@ -1,0 +1,66 @@
+//! The crate's error type.
+
+use thiserror::Error;
+
+/// Everything that can go wrong in a constitutive update.
+///
+/// Every variant names the offending value so that a caller (the solver)
+/// can attach the material point or load step and report it.
+#[derive(Debug, Clone, Copy, PartialEq, Error)]
+pub enum ConstitutiveError {
+    /// A deformation gradient (or its increment) with a non-positive
+    /// determinant: the motion inverts or annihilates the material.
+    #[error("det({which}) = {det:e} <= 0: the deformation inverts the material")]
+    NonPositiveJacobian {
+        /// Which tensor, e.g. `"ΔF"` or `"F_n"`.
+        which: &'static str,
+        /// Its determinant.
+        det: f64,
+    },
+    /// An input tensor or scalar holds NaN or infinity.
+    #[error("{which} has a non-finite entry ({value})")]
+    NonFinite {
+        /// Which input.
+        which: &'static str,
+        /// The first non-finite value found.
+        value: f64,
+    },
+    /// The previously converged elastic left Cauchy–Green tensor is not
+    /// symmetric positive definite.
+    #[error("the elastic left Cauchy–Green tensor b_e has eigenvalue {eigenvalue:e} <= 0")]
+    NotPositiveDefinite {
+        /// The smallest eigenvalue found.
+        eigenvalue: f64,
+    },
+    /// The symmetric eigen-solver did not converge.
+    #[error("symmetric eigen-decomposition did not converge")]
+    EigenDecomposition,
+    /// Young's modulus must be positive and finite.
+    #[error("Young's modulus E = {value} must be positive and finite")]
+    InvalidYoungsModulus {
+        /// The value given.
+        value: f64,
+    },
+    /// Poisson's ratio must lie in the open interval (-1, 0.5).
+    #[error("Poisson's ratio ν = {value} must lie in (-1, 0.5)")]
+    InvalidPoissonRatio {
+        /// The value given.
+        value: f64,
+    },
+    /// The yield stress must be positive and finite.
+    #[error("yield stress ρ_y = {value} must be positive and finite")]
+    InvalidYieldStress {
+        /// The value given.
+        value: f64,
+    },
+    /// The hardening modulus must be non-negative and finite (softening is
+    /// not supported: it makes the local problem ill-posed).
+    #[error("hardening modulus H = {value} must be non-negative and finite")]
+    InvalidHardening {
+        /// The value given.
+        value: f64,
+    },
+}
+
+/// Shorthand for results of this crate.
+pub type Result<T> = std::result::Result<T, ConstitutiveError>;

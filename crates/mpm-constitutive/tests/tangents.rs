@@ -1,0 +1,265 @@
+//! Finite-difference verification of every tangent of the crate
+//! (Coombs 2020, Appendix A), over random deformation gradients with
+//! rotations up to 180°, principal stretches 0.2–5, repeated and nearly
+//! repeated eigenvalues, ν up to 0.4999, elastic and yielding states,
+//! perfect and hardening plasticity.
+#![allow(clippy::unwrap_used)]
+
+mod common;
+
+use common::*;
+use mpm_constitutive::driver::cauchy_stress_derivative;
+use mpm_constitutive::tensor::Tensor4;
+use mpm_constitutive::{
+    ConsistentTangent, HenckyElastic, LogStrainLaw, MaterialState, PreviouslyConvergedTangent,
+    SpatialTangent, SymSpectral, VonMises, VonMisesHistory, update,
+};
+use nalgebra::Matrix3;
+use proptest::prelude::*;
+
+/// Required agreement of analytic and finite-difference tangents.
+const TOL: f64 = 1e-6;
+/// Finite-difference step relative to the smallest principal stretch (or
+/// eigenvalue) of the argument; see `common::central_difference`.
+const STEP: f64 = 1e-4;
+
+/// A random converged state: F_n with moderate stretches and, for the
+/// plastic model, a b_e^n that differs from F_n F_n^T (earlier plastic flow).
+fn converged_state() -> impl Strategy<Value = (Matrix3<f64>, Matrix3<f64>)> {
+    (
+        deformation_gradient(0.8, 1.25),
+        deformation_gradient(0.8, 1.25),
+    )
+        .prop_map(|(f_n, fe_n)| (f_n, fe_n * fe_n.transpose()))
+}
+
+/// A von Mises model whose yield stress is a random fraction of the trial
+/// deviatoric stress, so that both elastic and yielding steps are drawn.
+fn von_mises_for(
+    e: f64,
+    nu: f64,
+    fraction: f64,
+    hardening_ratio: f64,
+    delta_f: &Matrix3<f64>,
+    be_n: &Matrix3<f64>,
+    alpha_n: f64,
+) -> VonMises {
+    let elastic = HenckyElastic::new(e, nu).unwrap();
+    let trial = update(
+        &elastic,
+        delta_f,
+        &Matrix3::identity(),
+        &MaterialState {
+            be: *be_n,
+            history: (),
+        },
+    )
+    .unwrap();
+    let s = trial.tau - trial.tau.trace() / 3.0 * Matrix3::identity();
+    let mu = elastic.elasticity().mu;
+    let h = hardening_ratio * 2.0 * mu;
+    let rho_y = (fraction * s.norm() - h * alpha_n).max(1e-3 * mu);
+    VonMises::new(e, nu, rho_y, h).unwrap()
+}
+
+/// Ã against ∂P̃/∂ΔF (eqs. 18, A.3), for any law; `None` when the
+/// finite-difference stencil crosses the yield surface.
+fn check_previously_converged<L: LogStrainLaw>(
+    law: &L,
+    delta_f: &Matrix3<f64>,
+    f_n: &Matrix3<f64>,
+    state: &MaterialState<L::History>,
+) -> Option<f64> {
+    let r = update(law, delta_f, f_n, state).unwrap();
+    let a = PreviouslyConvergedTangent::tangent(law, &r).unwrap();
+    let h = STEP * min_singular_value(delta_f);
+    let fd = jacobian(
+        |d| {
+            let p = update(law, &(delta_f + d), f_n, state).unwrap();
+            (p.yielded() == r.yielded()).then(|| p.p_tilde())
+        },
+        unit,
+        h,
+    )?;
+    Some(rel(&a, &fd))
+}
+
+/// a against the push-forward J⁻¹F_jm (∂P_im/∂F_kn) F_ln with P = τF^{-T},
+/// and (∂σ_ij/∂F_km)F_lm against a − σ_ij δ_kl + σ_il δ_jk, both with the
+/// perturbation dF = G F (i.e. ΔF → (1 + tG)ΔF).
+fn check_spatial<L: LogStrainLaw>(
+    law: &L,
+    delta_f: &Matrix3<f64>,
+    f_n: &Matrix3<f64>,
+    state: &MaterialState<L::History>,
+) -> Option<(f64, f64)> {
+    let r = update(law, delta_f, f_n, state).unwrap();
+    let a = SpatialTangent::tangent(law, &r).unwrap();
+    let h = STEP * min_singular_value(delta_f) / delta_f.norm();
+    let perturbed = |g: &Matrix3<f64>| {
+        let p = update(law, &((Matrix3::identity() + g) * delta_f), f_n, state).unwrap();
+        (p.yielded() == r.yielded()).then_some(p)
+    };
+    let fd_push = jacobian(
+        |g| {
+            perturbed(g)
+                .map(|p| p.tau * p.f.try_inverse().unwrap().transpose() * r.f.transpose() / r.j)
+        },
+        unit,
+        h,
+    )?;
+    let fd_cauchy = jacobian(|g| perturbed(g).map(|p| p.sigma), unit, h)?;
+    let literal = cauchy_stress_derivative(&a, &r.sigma);
+    Some((rel(&a, &fd_push), rel(&literal, &fd_cauchy)))
+}
+
+proptest! {
+    #![proptest_config(common::config())]
+
+    #[test]
+    fn hencky_previously_converged_tangent_matches_finite_differences(
+        delta_f in deformation_gradient(0.2, 5.0),
+        f_n in deformation_gradient(0.8, 1.25),
+        e in 1e3f64..1e7,
+        nu in poisson_ratio(),
+    ) {
+        let law = HenckyElastic::new(e, nu).unwrap();
+        let state = MaterialState { be: f_n * f_n.transpose(), history: () };
+        let err = check_previously_converged(&law, &delta_f, &f_n, &state).unwrap();
+        prop_assert!(err <= TOL, "relative error {err:e}");
+    }
+
+    #[test]
+    fn von_mises_previously_converged_tangent_matches_finite_differences(
+        delta_f in deformation_gradient(0.2, 5.0),
+        (f_n, be_n) in converged_state(),
+        nu in poisson_ratio(),
+        fraction in 0.05f64..2.0,
+        hardening_ratio in prop_oneof![Just(0.0), 0.0f64..1.0],
+        alpha_n in prop_oneof![Just(0.0), 0.0f64..0.2],
+    ) {
+        let law = von_mises_for(1e4, nu, fraction, hardening_ratio, &delta_f, &be_n, alpha_n);
+        let state = MaterialState { be: be_n, history: VonMisesHistory { alpha: alpha_n } };
+        let err = check_previously_converged(&law, &delta_f, &f_n, &state);
+        prop_assume!(err.is_some(), "stencil crosses the yield surface");
+        let err = err.unwrap();
+        prop_assert!(err <= TOL, "relative error {err:e}");
+    }
+
+    #[test]
+    fn hencky_spatial_tangent_matches_finite_differences(
+        delta_f in deformation_gradient(0.2, 5.0),
+        f_n in deformation_gradient(0.8, 1.25),
+        nu in poisson_ratio(),
+    ) {
+        let law = HenckyElastic::new(2e5, nu).unwrap();
+        let state = MaterialState { be: f_n * f_n.transpose(), history: () };
+        let (push, literal) = check_spatial(&law, &delta_f, &f_n, &state).unwrap();
+        prop_assert!(push <= TOL, "push-forward relative error {push:e}");
+        prop_assert!(literal <= TOL, "(dσ/dF)F relative error {literal:e}");
+    }
+
+    #[test]
+    fn von_mises_spatial_tangent_matches_finite_differences(
+        delta_f in deformation_gradient(0.2, 5.0),
+        (f_n, be_n) in converged_state(),
+        nu in poisson_ratio(),
+        fraction in 0.05f64..2.0,
+        hardening_ratio in prop_oneof![Just(0.0), 0.0f64..1.0],
+    ) {
+        let law = von_mises_for(1e4, nu, fraction, hardening_ratio, &delta_f, &be_n, 0.0);
+        let state = MaterialState { be: be_n, history: VonMisesHistory::default() };
+        let errs = check_spatial(&law, &delta_f, &f_n, &state);
+        prop_assume!(errs.is_some(), "stencil crosses the yield surface");
+        let (push, literal) = errs.unwrap();
+        prop_assert!(push <= TOL, "push-forward relative error {push:e}");
+        prop_assert!(literal <= TOL, "(dσ/dF)F relative error {literal:e}");
+    }
+
+    #[test]
+    fn algorithmic_tangent_matches_finite_differences(
+        strain_f in deformation_gradient(0.2, 5.0),
+        nu in poisson_ratio(),
+        fraction in 0.05f64..2.0,
+        hardening_ratio in prop_oneof![Just(0.0), 0.0f64..1.0],
+    ) {
+        // ε^tr = ½ ln(F Fᵀ): a random symmetric strain with the same
+        // eigenvalue structure as the kinematics produce.
+        let eps = SymSpectral::new(&(strain_f * strain_f.transpose())).unwrap().log().unwrap() * 0.5;
+        let elastic = HenckyElastic::new(1e4, nu).unwrap();
+        let (tau_e, _) = elastic.kirchhoff_stress(&eps, &()).unwrap();
+        let s_norm = (tau_e - tau_e.trace() / 3.0 * Matrix3::identity()).norm();
+        let mu = elastic.elasticity().mu;
+        let law = VonMises::new(1e4, nu, (fraction * s_norm).max(1e-3 * mu), hardening_ratio * 2.0 * mu).unwrap();
+        let history = VonMisesHistory::default();
+        let trial = SymSpectral::new(&eps).unwrap();
+        let state = law.return_map(&trial, &history);
+        let d = law.algorithmic_tangent(&trial, &history, &state);
+        let h = STEP;
+        let fd = jacobian(
+            |de| {
+                let (tau, s) = law.kirchhoff_stress(&(eps + de), &history).unwrap();
+                (s.yielded == state.yielded).then_some(tau)
+            },
+            sym_unit,
+            h,
+        );
+        prop_assume!(fd.is_some(), "stencil crosses the yield surface");
+        let err = rel(&d, &fd.unwrap());
+        prop_assert!(err <= TOL, "D_alg relative error {err:e} (yielded: {})", state.yielded);
+        // Hencky: D^e exactly.
+        let d_e = elastic.algorithmic_tangent(&trial, &(), &elastic.return_map(&trial, &()));
+        let fd_e = jacobian(|de| Some(elastic.kirchhoff(&(eps + de))), sym_unit, h).unwrap();
+        prop_assert!(rel(&d_e, &fd_e) <= TOL);
+    }
+
+    #[test]
+    fn dlog_matches_finite_differences(f in deformation_gradient(0.2, 5.0)) {
+        let b = f * f.transpose();
+        let s = SymSpectral::new(&b).unwrap();
+        let l = s.dlog().unwrap();
+        let h = STEP * s.min_value();
+        let fd = jacobian(|db| SymSpectral::new(&(b + db)).unwrap().log().ok(), sym_unit, h).unwrap();
+        let err = rel(&l, &fd);
+        prop_assert!(err <= TOL, "L relative error {err:e}");
+    }
+
+    #[test]
+    fn cauchy_stress_is_objective(
+        delta_f in deformation_gradient(0.2, 5.0),
+        (f_n, be_n) in converged_state(),
+        q in rotation(),
+        nu in poisson_ratio(),
+        fraction in 0.05f64..2.0,
+    ) {
+        let law = von_mises_for(1e4, nu, fraction, 0.1, &delta_f, &be_n, 0.0);
+        let state = MaterialState { be: be_n, history: VonMisesHistory::default() };
+        let r = update(&law, &delta_f, &f_n, &state).unwrap();
+        let rq = update(&law, &(q * delta_f), &f_n, &state).unwrap();
+        let expected = q * r.sigma * q.transpose();
+        let err = (rq.sigma - expected).norm() / r.sigma.norm().max(1e-12 * law.yield_stress());
+        prop_assert!(err <= 1e-10, "objectivity error {err:e}");
+        prop_assert_eq!(r.yielded(), rq.yielded());
+        // The previously converged tangent obeys Ã(QΔF) = Q·Ã(ΔF) on the first index.
+        let a = PreviouslyConvergedTangent::tangent(&law, &r).unwrap();
+        let aq = PreviouslyConvergedTangent::tangent(&law, &rq).unwrap();
+        let qa = rotate_first_and_third(&a, &q);
+        prop_assert!(rel(&aq, &qa) <= 1e-9);
+    }
+}
+
+/// (Q·Ã)_ijkl = Q_ia Ã_ajbl Q_kb: P̃(QΔF) = Q P̃(ΔF), and a perturbation
+/// dΔF of QΔF is Q (QᵀdΔF).
+fn rotate_first_and_third(a: &Tensor4, q: &Matrix3<f64>) -> Tensor4 {
+    use mpm_constitutive::tensor::idx;
+    Tensor4::from_fn(|r, c| {
+        let (i, j, k, l) = (r / 3, r % 3, c / 3, c % 3);
+        let mut v = 0.0;
+        for p in 0..3 {
+            for m in 0..3 {
+                v += q[(i, p)] * a[(idx(p, j), idx(m, l))] * q[(k, m)];
+            }
+        }
+        v
+    })
+}
