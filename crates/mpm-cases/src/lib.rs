@@ -6,3 +6,8 @@
 //! elasto-plastic collapse) and of Wang et al. 2021, each as data selected by
 //! name or by a scene file, and the `mpm` command-line program that runs
 //! them. The program arrives with the solver.
+
+pub mod error;
+pub mod output;
+
+pub use error::CasesError;

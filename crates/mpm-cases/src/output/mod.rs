@@ -1,0 +1,21 @@
+//! Result files of a run: VTK grids and their time series for ParaView,
+//! CSV tables, and `summary.json`.
+//!
+//! Every writer takes plain slices and names (no solver types), refuses
+//! NaN and infinity with an error naming the array and index, and replaces
+//! its file atomically through [`atomic_write`], so an interrupted run
+//! leaves only complete files behind and can be resumed.
+
+mod atomic;
+pub mod csv;
+mod finite;
+pub mod pvd;
+pub mod summary;
+mod text;
+pub mod vtk;
+
+pub use atomic::{atomic_write, atomic_write_with};
+pub use csv::{CsvTable, CsvValue};
+pub use pvd::{PvdSeries, PvdStep};
+pub use summary::{summary_json, write_summary};
+pub use vtk::{CellType, UnstructuredGrid, Values};
