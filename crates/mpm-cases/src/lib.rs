@@ -9,5 +9,6 @@
 
 pub mod error;
 pub mod output;
+pub mod scene_file;
 
 pub use error::CasesError;

@@ -1,0 +1,340 @@
+//! Scene files: TOML documents deserialised into a scene type of the
+//! caller's choosing, with command-line overrides.
+//!
+//! ```
+//! use serde::Deserialize;
+//! use mpm_cases::scene_file::parse_scene;
+//!
+//! #[derive(Deserialize)]
+//! #[serde(deny_unknown_fields)]
+//! struct Material { #[serde(rename = "E")] e: f64, nu: f64 }
+//!
+//! #[derive(Deserialize)]
+//! #[serde(deny_unknown_fields)]
+//! struct Scene { h: f64, basis: String, material: Material }
+//!
+//! let text = "h = 0.5\nbasis = \"mpm\"\n[material]\nE = 1e6\nnu = 0.3\n";
+//! let overrides = ["material.E=2e6".to_owned(), "basis=gimp".to_owned()];
+//! let scene: Scene = parse_scene(text, "scene.toml", &overrides)?;
+//! assert_eq!(scene.material.e, 2e6);
+//! assert_eq!(scene.basis, "gimp");
+//! # Ok::<(), mpm_cases::CasesError>(())
+//! ```
+//!
+//! # Overrides
+//! Each override is `key=value`. The key is a dotted path of bare keys
+//! (`material.E`); tables on the path that do not exist are created. The
+//! value is read as a TOML value if it is one (`1e6`, `true`, `[1, 2]`,
+//! `{ E = 1e6, nu = 0.3 }`, `"quoted"`) and taken as a string otherwise
+//! (`gimp`), so `basis=gimp` needs no shell-quoted quotes. Overrides are
+//! applied in order to the parsed document before it is deserialised, so
+//! the scene type's `#[serde(deny_unknown_fields)]` rejects an unknown
+//! override key just as it rejects an unknown key in the file.
+//!
+//! # Errors
+//! A problem in the file is reported as `origin:line:column: message` (1-based,
+//! columns in characters); a problem caused by an override names the
+//! override instead. NaN and infinite floats (`nan`, `inf`, or a literal too
+//! large for `f64`) are refused wherever they appear.
+
+use std::borrow::Cow;
+use std::ops::Range;
+use std::path::Path;
+
+use serde::de::DeserializeOwned;
+use toml::Spanned;
+use toml::de::{DeTable, DeValue};
+
+use crate::CasesError;
+
+/// Reads the TOML scene at `path`, applies `overrides` and deserialises the
+/// result into `T`.
+///
+/// Errors name the file by `path` as given.
+///
+/// # Errors
+/// [`CasesError::Io`] if the file cannot be read; otherwise as
+/// [`parse_scene`].
+pub fn load_scene<T: DeserializeOwned>(path: &Path, overrides: &[String]) -> Result<T, CasesError> {
+    let text = std::fs::read_to_string(path).map_err(|source| CasesError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_scene(&text, &path.display().to_string(), overrides)
+}
+
+/// Parses the TOML scene `text`, applies `overrides` and deserialises the
+/// result into `T`. `origin` (usually the file name) prefixes error
+/// messages.
+///
+/// # Errors
+/// [`CasesError::MalformedOverride`] for an override without `=`, with an
+/// empty key, key segment or value; [`CasesError::Scene`] for malformed TOML,
+/// an unknown key, a wrong type or a non-finite float in `text`, with line
+/// and column; [`CasesError::Override`] when an override cannot be applied
+/// (its path crosses a non-table value) or is what makes the scene invalid;
+/// [`CasesError::SceneUnlocated`] if the deserialiser gives no position.
+pub fn parse_scene<T: DeserializeOwned>(
+    text: &str,
+    origin: &str,
+    overrides: &[String],
+) -> Result<T, CasesError> {
+    let parsed: Vec<Override<'_>> = overrides
+        .iter()
+        .map(|o| Override::parse(o))
+        .collect::<Result<_, _>>()?;
+    let locate = Locator::new(text, origin, &parsed);
+
+    let mut root = DeTable::parse(text).map_err(|e| locate.error(e.span(), e.message()))?;
+    if let Some(span) = first_non_finite_in_table(root.get_ref()) {
+        return Err(locate.non_finite(span));
+    }
+    for (k, o) in parsed.iter().enumerate() {
+        o.apply(root.get_mut(), locate.span_of(k))?;
+    }
+    // An error carrying the root table's span (e.g. a missing top-level key)
+    // says nothing about where: it is reported without a position.
+    let root_span = root.span();
+    T::deserialize(toml::de::Deserializer::from(root)).map_err(|e| {
+        let span = e.span().filter(|s| *s != root_span);
+        locate.error(span, e.message())
+    })
+}
+
+/// One `key=value` override, split and checked.
+struct Override<'a> {
+    text: &'a str,
+    keys: Vec<&'a str>,
+    value: &'a str,
+}
+
+impl<'a> Override<'a> {
+    fn parse(text: &'a str) -> Result<Self, CasesError> {
+        let malformed = |reason| CasesError::MalformedOverride {
+            text: text.to_owned(),
+            reason,
+        };
+        let (key, value) = text.split_once('=').ok_or_else(|| malformed("no `=`"))?;
+        let (key, value) = (key.trim(), value.trim());
+        if key.is_empty() {
+            return Err(malformed("empty key"));
+        }
+        let keys: Vec<&str> = key.split('.').map(str::trim).collect();
+        if keys.iter().any(|k| k.is_empty()) {
+            return Err(malformed(
+                "empty key segment (a leading, trailing or doubled `.`)",
+            ));
+        }
+        if value.is_empty() {
+            return Err(malformed(
+                "empty value (write key=\"\" for an empty string)",
+            ));
+        }
+        Ok(Self { text, keys, value })
+    }
+
+    fn error(&self, message: impl Into<String>) -> CasesError {
+        CasesError::Override {
+            text: self.text.to_owned(),
+            message: message.into(),
+        }
+    }
+
+    /// The override's value: TOML if it parses as a TOML value, else a
+    /// string; every span set to `span`, so that deserialisation errors in
+    /// it are traced back to this override.
+    fn value(&self, span: &Range<usize>) -> Result<Spanned<DeValue<'a>>, CasesError> {
+        let value = match DeValue::parse(self.value) {
+            Ok(v) => v,
+            Err(_) => Spanned::new(0..0, DeValue::String(Cow::Borrowed(self.value))),
+        };
+        if first_non_finite(&value).is_some() {
+            return Err(self.error("NaN and infinite values are not allowed in a scene"));
+        }
+        Ok(respan(value, span))
+    }
+
+    /// Inserts the value into `root` at the override's key path.
+    fn apply(&self, root: &mut DeTable<'a>, span: Range<usize>) -> Result<(), CasesError> {
+        let value = self.value(&span)?;
+        let (last, parents) = self
+            .keys
+            .split_last()
+            .ok_or_else(|| self.error("empty key"))?;
+        let mut table = root;
+        for (depth, &key) in parents.iter().enumerate() {
+            if !table.contains_key(key) {
+                table.insert(
+                    Spanned::new(span.clone(), Cow::Borrowed(key)),
+                    Spanned::new(span.clone(), DeValue::Table(DeTable::new())),
+                );
+            }
+            table = match table.get_mut(key).map(Spanned::get_mut) {
+                Some(DeValue::Table(t)) => t,
+                Some(other) => {
+                    return Err(self.error(format!(
+                        "`{}` is {}, not a table",
+                        self.keys[..=depth].join("."),
+                        article(other.type_str())
+                    )));
+                }
+                None => return Err(self.error("internal error: table just inserted is missing")),
+            };
+        }
+        match table.get_mut(*last) {
+            Some(existing) => *existing = value,
+            None => {
+                table.insert(Spanned::new(span, Cow::Borrowed(*last)), value);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `"an integer"`, `"a table"`.
+fn article(type_name: &str) -> String {
+    if type_name.starts_with(['a', 'e', 'i', 'o', 'u']) {
+        format!("an {type_name}")
+    } else {
+        format!("a {type_name}")
+    }
+}
+
+/// `value` with its own span and every nested span replaced by `span`.
+fn respan<'a>(value: Spanned<DeValue<'a>>, span: &Range<usize>) -> Spanned<DeValue<'a>> {
+    let inner = match value.into_inner() {
+        DeValue::Array(items) => {
+            DeValue::Array(items.into_iter().map(|v| respan(v, span)).collect())
+        }
+        DeValue::Table(table) => DeValue::Table(
+            table
+                .into_iter()
+                .map(|(k, v)| (Spanned::new(span.clone(), k.into_inner()), respan(v, span)))
+                .collect(),
+        ),
+        scalar => scalar,
+    };
+    Spanned::new(span.clone(), inner)
+}
+
+/// The span of the first NaN or infinite float in `value`.
+fn first_non_finite(value: &Spanned<DeValue<'_>>) -> Option<Range<usize>> {
+    match value.get_ref() {
+        DeValue::Float(f) => {
+            let digits: String = f.as_str().chars().filter(|&c| c != '_').collect();
+            match digits.parse::<f64>() {
+                Ok(x) if x.is_finite() => None,
+                _ => Some(value.span()),
+            }
+        }
+        DeValue::Array(items) => items.iter().find_map(first_non_finite),
+        DeValue::Table(table) => first_non_finite_in_table(table),
+        _ => None,
+    }
+}
+
+fn first_non_finite_in_table(table: &DeTable<'_>) -> Option<Range<usize>> {
+    table.values().find_map(first_non_finite)
+}
+
+/// Maps byte spans to places: in the file, or in one of the overrides,
+/// which are given spans past the end of the file.
+struct Locator<'a> {
+    text: &'a str,
+    origin: &'a str,
+    overrides: &'a [Override<'a>],
+    /// Start of each override's virtual span.
+    starts: Vec<usize>,
+}
+
+impl<'a> Locator<'a> {
+    fn new(text: &'a str, origin: &'a str, overrides: &'a [Override<'a>]) -> Self {
+        let mut starts = Vec::with_capacity(overrides.len());
+        let mut next = text.len() + 1;
+        for o in overrides {
+            starts.push(next);
+            next += o.text.len().max(1) + 1;
+        }
+        Self {
+            text,
+            origin,
+            overrides,
+            starts,
+        }
+    }
+
+    /// The virtual span of override `k`.
+    fn span_of(&self, k: usize) -> Range<usize> {
+        let start = self.starts[k];
+        start..start + self.overrides[k].text.len().max(1)
+    }
+
+    fn error(&self, span: Option<Range<usize>>, message: &str) -> CasesError {
+        let message = message.trim_end().to_owned();
+        let Some(span) = span else {
+            return CasesError::SceneUnlocated {
+                origin: self.origin.to_owned(),
+                message,
+            };
+        };
+        if span.start > self.text.len() {
+            let k = self
+                .starts
+                .partition_point(|&s| s <= span.start)
+                .saturating_sub(1);
+            if let Some(o) = self.overrides.get(k) {
+                return o.error(message);
+            }
+        }
+        let (line, column) = line_column(self.text, span.start);
+        CasesError::Scene {
+            origin: self.origin.to_owned(),
+            line,
+            column,
+            message,
+        }
+    }
+
+    fn non_finite(&self, span: Range<usize>) -> CasesError {
+        let literal = self.text.get(span.clone()).unwrap_or("").trim();
+        self.error(
+            Some(span),
+            &format!("the float `{literal}` is not finite: NaN and infinite values are not allowed in a scene"),
+        )
+    }
+}
+
+/// 1-based line and column (in characters) of byte `offset` in `text`.
+///
+/// An offset past the end is clamped to the end; one inside a multi-byte
+/// character is moved back to its start.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let mut offset = offset.min(text.len());
+    while !text.is_char_boundary(offset) {
+        offset -= 1;
+    }
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let column = before[line_start..].chars().count() + 1;
+    (line, column)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::line_column;
+
+    #[test]
+    fn line_column_is_one_based_in_characters() {
+        let text = "a = 1\nbé = 2\n\nc";
+        assert_eq!(line_column(text, 0), (1, 1));
+        assert_eq!(line_column(text, 4), (1, 5));
+        assert_eq!(line_column(text, 6), (2, 1));
+        // 'é' is two bytes; the '=' after "bé " is the fourth character.
+        assert_eq!(line_column(text, 10), (2, 4));
+        // Inside 'é' moves back to its start.
+        assert_eq!(line_column(text, 8), (2, 2));
+        assert_eq!(line_column(text, text.len()), (4, 2));
+        assert_eq!(line_column(text, 1000), (4, 2));
+    }
+}
