@@ -40,6 +40,12 @@ pub trait LogStrainLaw: Send + Sync {
     /// elasticity, so elastic scenes carry no plastic state.
     type History: Copy + Default + Debug + PartialEq + Send + Sync + 'static;
 
+    /// Whether $D^{alg}$ is major-symmetric. Then the global stiffness of
+    /// either formulation is symmetric (it is the Hessian of an algorithmic
+    /// potential) and the solver may use Cholesky. True for hyperelastic
+    /// laws and associated plasticity with a closest-point return.
+    const SYMMETRIC_TANGENT: bool = true;
+
     /// The return map: stress, elastic strain and history from the trial
     /// elastic strain (given spectrally) and the converged history.
     fn return_map(&self, trial: &SymSpectral, history: &Self::History) -> LawState<Self::History>;

@@ -1,9 +1,33 @@
 //! Generic material point solvers.
 //!
-//! This crate will hold the plug-point traits `Formulation` (updated
-//! Lagrangian / previously converged, Coombs et al. 2020 §3 and §5),
-//! `LockingTreatment` (none / F-bar / F-patch / cell-averaged dilatation)
-//! and `DomainUpdater` (the GIMP domain-update rules, Coombs et al. 2020
-//! §6.4), and the solvers composed from them: an implicit Newton–Raphson
-//! solver for quasi-static problems and an explicit dynamic solver. The
-//! solvers depend on traits only, never on a concrete implementation.
+//! The plug-point traits live here and the solvers depend on nothing else:
+//! [`Formulation`] (updated Lagrangian / previously converged, Coombs et
+//! al. 2020 §3 and §5), [`LockingTreatment`] (none now; F-bar / F-patch /
+//! cell-averaged dilatation to come), [`DomainUpdater`] (the GIMP
+//! domain-update rules, §6.4), [`Constraints`] (Dirichlet conditions on the
+//! grid) and, from `mpm-basis`, `BasisFunction`. [`ImplicitSolver`]
+//! composes them into the quasi-static Newton–Raphson solver of §6.3 and
+//! [`run`] drives it through load steps with automatic step control.
+
+pub mod boundary;
+pub mod domain;
+pub mod error;
+pub mod formulation;
+pub mod implicit;
+pub mod linear;
+pub mod locking;
+pub mod mesh;
+pub mod points;
+pub mod stepping;
+pub mod system;
+
+pub use boundary::{Constraints, NodalConstraints};
+pub use domain::{DomainContext, DomainError, DomainUpdater, NoUpdate, StretchU};
+pub use error::{SolverError, StepFailure};
+pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
+pub use implicit::{ImplicitSolver, NewtonOptions, StepError, StepReport};
+pub use linear::{Factorisation, LinearSolver};
+pub use locking::{LockingTreatment, NoLocking};
+pub use mesh::NodalMesh;
+pub use points::MaterialPoints;
+pub use stepping::{LoadStepping, RunSummary};

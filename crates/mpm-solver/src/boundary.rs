@@ -1,0 +1,72 @@
+//! Dirichlet conditions on grid nodes (Coombs 2020 §6.2: imposed directly
+//! on the background mesh as in the finite element method).
+
+/// Prescribed displacement increments of grid degrees of freedom.
+pub trait Constraints<const D: usize>: Send + Sync {
+    /// The prescribed displacement increment of component `component` of
+    /// mesh node `node` over the load step from load factor `lambda0` to
+    /// `lambda1`, or `None` if the degree of freedom is free.
+    fn prescribed(&self, node: usize, component: usize, lambda0: f64, lambda1: f64) -> Option<f64>;
+}
+
+/// Fixed and prescribed degrees of freedom listed per node: fixed nodes
+/// (supports, rollers) have zero increments, prescribed ones move linearly
+/// with the load factor, reaching their value at load factor 1.
+#[derive(Debug, Clone)]
+pub struct NodalConstraints<const D: usize> {
+    total: Vec<Option<f64>>,
+}
+
+impl<const D: usize> NodalConstraints<D> {
+    /// No constraints on a mesh of `node_count` nodes.
+    pub fn new(node_count: usize) -> Self {
+        Self {
+            total: vec![None; node_count * D],
+        }
+    }
+
+    /// Fixes component `component` of every node in `nodes` (a roller on a
+    /// face fixes the normal component; a pin fixes all).
+    pub fn fix(&mut self, nodes: impl IntoIterator<Item = usize>, component: usize) -> &mut Self {
+        self.prescribe(nodes, component, 0.0)
+    }
+
+    /// Prescribes component `component` of every node in `nodes` to reach
+    /// `displacement` at load factor 1. Out-of-range nodes are ignored.
+    pub fn prescribe(
+        &mut self,
+        nodes: impl IntoIterator<Item = usize>,
+        component: usize,
+        displacement: f64,
+    ) -> &mut Self {
+        if component < D {
+            for n in nodes {
+                if let Some(slot) = self.total.get_mut(n * D + component) {
+                    *slot = Some(displacement);
+                }
+            }
+        }
+        self
+    }
+
+    /// Number of constrained degrees of freedom.
+    pub fn len(&self) -> usize {
+        self.total.iter().filter(|v| v.is_some()).count()
+    }
+
+    /// Whether nothing is constrained.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl<const D: usize> Constraints<D> for NodalConstraints<D> {
+    #[inline]
+    fn prescribed(&self, node: usize, component: usize, lambda0: f64, lambda1: f64) -> Option<f64> {
+        self.total
+            .get(node * D + component)
+            .copied()
+            .flatten()
+            .map(|u| u * (lambda1 - lambda0))
+    }
+}

@@ -1,0 +1,688 @@
+//! The generic implicit Newton–Raphson solver for quasi-static problems
+//! (Coombs et al. 2020 §6.3; the algorithm of AMPLE, Coombs & Augarde 2020).
+//!
+//! One load step, [`ImplicitSolver::solve_load_step`], is the paper's
+//! algorithm:
+//!
+//! 1. [`evaluate_basis`](ImplicitSolver::evaluate_basis): basis values and
+//!    gradients at the start of the step, once per step;
+//! 2. [`build_system`](ImplicitSolver::build_system): active nodes, dofs,
+//!    prescribed increments, sparsity pattern, symbolic factorisation;
+//! 3. [`assemble_external_force`](ImplicitSolver::assemble_external_force):
+//!    eqs. (24), (25), (29);
+//! 4. Newton iterations: [`update_material_points`](ImplicitSolver::update_material_points)
+//!    (eq. 7, the constitutive update), [`assemble_internal_force`](ImplicitSolver::assemble_internal_force)
+//!    (eqs. 6/23, 28), the convergence check on eq. (40), then
+//!    [`assemble_stiffness`](ImplicitSolver::assemble_stiffness) (eqs. 4/21, 27)
+//!    and the linear solve (eqs. 26, 30);
+//! 5. [`commit`](ImplicitSolver::commit): positions (eq. 31), deformation,
+//!    volumes, history and domains.
+//!
+//! Material-point loops run in parallel with rayon; every sum is taken in
+//! an order fixed by point and node numbering, so results do not depend on
+//! the number of threads.
+
+use std::marker::PhantomData;
+
+use mpm_basis::{BasisFunction, Stencil};
+use mpm_constitutive::tensor::{Tensor4, embed, idx};
+use mpm_constitutive::{ConsistentTangent, LogStrainLaw, MaterialState, Response, update};
+use nalgebra::{Matrix3, SMatrix, SVector};
+use rayon::prelude::*;
+
+use crate::boundary::Constraints;
+use crate::domain::{DomainContext, DomainError, DomainUpdater};
+use crate::error::{SolverError, StepFailure};
+use crate::formulation::Formulation;
+use crate::linear::{Factorisation, LinearSolver};
+use crate::locking::LockingTreatment;
+use crate::mesh::NodalMesh;
+use crate::points::MaterialPoints;
+use crate::system::{NONE, StepSystem};
+
+/// Newton–Raphson controls.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonOptions {
+    /// Tolerance on the normalised out-of-balance force, eq. (40).
+    pub tolerance: f64,
+    /// Maximum number of iterations (linear solves) per step.
+    pub max_iterations: usize,
+    /// The step is declared divergent when the normalised residual exceeds
+    /// this factor times its value at iteration 0.
+    pub divergence_factor: f64,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-9,
+            max_iterations: 30,
+            divergence_factor: 1e6,
+        }
+    }
+}
+
+/// What one converged load step did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepReport<const D: usize> {
+    /// Load factor at the start of the step.
+    pub lambda0: f64,
+    /// Load factor at the end of the step.
+    pub lambda1: f64,
+    /// Normalised residual (eq. 40) at iterations 0, 1, ...
+    pub residuals: Vec<f64>,
+    /// Sum of the reactions at prescribed dofs, per component.
+    pub reaction: SVector<f64, D>,
+    /// Active nodes, free dofs and stiffness entries of the step.
+    pub active_nodes: usize,
+    /// Free degrees of freedom.
+    pub free_dofs: usize,
+    /// Factorisation used by the last solve.
+    pub factorisation: Option<Factorisation>,
+}
+
+impl<const D: usize> StepReport<D> {
+    /// Number of Newton iterations (linear solves).
+    pub fn iterations(&self) -> usize {
+        self.residuals.len().saturating_sub(1)
+    }
+}
+
+/// Failure of one attempt at a load step.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepError {
+    /// The step may succeed with a smaller increment.
+    Retry {
+        /// The cause.
+        cause: StepFailure,
+        /// The last normalised residual.
+        last_residual: f64,
+    },
+    /// The simulation cannot continue (e.g. a point left the grid).
+    Fatal(SolverError),
+}
+
+impl From<SolverError> for StepError {
+    fn from(e: SolverError) -> Self {
+        StepError::Fatal(e)
+    }
+}
+
+/// Per-iteration buffers, sized once per step.
+#[derive(Debug)]
+struct Iterate<const D: usize, H> {
+    du: Vec<f64>,
+    f_ext: Vec<f64>,
+    f_int: Vec<f64>,
+    rhs: Vec<f64>,
+    values: Vec<f64>,
+    responses: Vec<Option<Response<H>>>,
+    stress_w: Vec<Matrix3<f64>>,
+    tangent_w: Vec<Tensor4>,
+    mapped: Vec<SVector<f64, D>>,
+    increments: Vec<Matrix3<f64>>,
+    volumes: Vec<f64>,
+}
+
+impl<const D: usize, H> Default for Iterate<D, H> {
+    fn default() -> Self {
+        Self {
+            du: Vec::new(),
+            f_ext: Vec::new(),
+            f_int: Vec::new(),
+            rhs: Vec::new(),
+            values: Vec::new(),
+            responses: Vec::new(),
+            stress_w: Vec::new(),
+            tangent_w: Vec::new(),
+            mapped: Vec::new(),
+            increments: Vec::new(),
+            volumes: Vec::new(),
+        }
+    }
+}
+
+/// The implicit quasi-static solver, generic over dimension `D`, basis `B`,
+/// formulation `F`, material law `L`, locking treatment `K`, domain updater
+/// `U` and Dirichlet conditions `C`. Every combination monomorphises; a
+/// scene pays only for the components it names.
+pub struct ImplicitSolver<const D: usize, B, F, L, K, U, C>
+where
+    B: BasisFunction<D>,
+    L: LogStrainLaw,
+{
+    /// The basis.
+    pub basis: B,
+    /// The background mesh.
+    pub mesh: B::Mesh,
+    /// The material law (one material per body).
+    pub law: L,
+    /// The locking treatment.
+    pub locking: K,
+    /// The domain updater.
+    pub updater: U,
+    /// Dirichlet conditions.
+    pub constraints: C,
+    /// Newton controls.
+    pub options: NewtonOptions,
+    system: StepSystem<D>,
+    it: Iterate<D, L::History>,
+    linear: Option<LinearSolver>,
+    _formulation: PhantomData<F>,
+}
+
+impl<const D: usize, B, F, L, K, U, C> ImplicitSolver<D, B, F, L, K, U, C>
+where
+    B: BasisFunction<D>,
+    B::Mesh: NodalMesh,
+    F: Formulation,
+    L: LogStrainLaw,
+    K: LockingTreatment,
+    U: DomainUpdater<D, B::Domain>,
+    C: Constraints<D>,
+{
+    /// Composes a solver.
+    pub fn new(basis: B, mesh: B::Mesh, law: L, locking: K, updater: U, constraints: C, options: NewtonOptions) -> Self {
+        Self {
+            basis,
+            mesh,
+            law,
+            locking,
+            updater,
+            constraints,
+            options,
+            system: StepSystem::default(),
+            it: Iterate::default(),
+            linear: None,
+            _formulation: PhantomData,
+        }
+    }
+
+    /// Solves the load step from load factor `lambda0` to `lambda1`: the
+    /// stages of the module docs. On success the points hold the converged
+    /// state; on failure they are untouched.
+    pub fn solve_load_step(
+        &mut self,
+        points: &mut MaterialPoints<D, L::History, B::Domain>,
+        lambda0: f64,
+        lambda1: f64,
+    ) -> Result<StepReport<D>, StepError> {
+        self.evaluate_basis(points)?;
+        self.build_system(lambda0, lambda1)?;
+        self.assemble_external_force(points, lambda1);
+        let mut residuals = Vec::new();
+        loop {
+            let iteration = residuals.len();
+            self.update_material_points(points).map_err(|cause| StepError::Retry {
+                cause,
+                last_residual: residuals.last().copied().unwrap_or(f64::NAN),
+            })?;
+            self.assemble_internal_force();
+            let residual = self.normalised_residual();
+            residuals.push(residual);
+            if residual <= self.options.tolerance {
+                break;
+            }
+            if !residual.is_finite() || residual > self.options.divergence_factor * residuals[0].max(self.options.tolerance) {
+                return Err(StepError::Retry {
+                    cause: StepFailure::Diverged { iteration, residual },
+                    last_residual: residual,
+                });
+            }
+            if iteration >= self.options.max_iterations {
+                return Err(StepError::Retry {
+                    cause: StepFailure::IterationLimit { iterations: iteration, residual },
+                    last_residual: residual,
+                });
+            }
+            self.update_tangents(points).map_err(|cause| StepError::Retry {
+                cause,
+                last_residual: residual,
+            })?;
+            self.assemble_stiffness();
+            self.solve().map_err(|reason| StepError::Retry {
+                cause: StepFailure::LinearSolve { reason },
+                last_residual: residual,
+            })?;
+        }
+        let reaction = self.reaction();
+        self.commit(points)?;
+        Ok(StepReport {
+            lambda0,
+            lambda1,
+            residuals,
+            reaction,
+            active_nodes: self.system.n_active(),
+            free_dofs: self.system.n_free,
+            factorisation: self.linear.as_ref().and_then(LinearSolver::last_factorisation),
+        })
+    }
+
+    /// Stage 1: basis values and gradients of every point at the start of
+    /// the step, into fixed-stride slots (no allocation per point: each
+    /// worker reuses one stencil buffer).
+    pub fn evaluate_basis(&mut self, points: &MaterialPoints<D, L::History, B::Domain>) -> Result<(), SolverError> {
+        let n = points.len();
+        let stride = B::MAX_NODES;
+        let sys = &mut self.system;
+        sys.stride = stride;
+        sys.nodes.clear();
+        sys.nodes.resize(n * stride, 0);
+        sys.values.clear();
+        sys.values.resize(n * stride, 0.0);
+        sys.grads.clear();
+        sys.grads.resize(n * stride, SVector::zeros());
+        sys.counts.clear();
+        sys.counts.resize(n, 0);
+        let (basis, mesh) = (&self.basis, &self.mesh);
+        let node_count = mesh.node_count();
+        sys.nodes
+            .par_chunks_mut(stride)
+            .zip(sys.values.par_chunks_mut(stride))
+            .zip(sys.grads.par_chunks_mut(stride))
+            .zip(sys.counts.par_iter_mut())
+            .enumerate()
+            .try_for_each_init(
+                || Stencil::<D>::with_capacity(stride),
+                |stencil, (p, (((nodes, values), grads), count))| {
+                    let x = &points.position[p];
+                    basis
+                        .evaluate(mesh, x, &points.domain[p], stencil)
+                        .map_err(|e| SolverError::Basis {
+                            point: p,
+                            position: x.iter().copied().collect(),
+                            reason: e.to_string(),
+                        })?;
+                    let m = stencil.nodes.len();
+                    if m > stride || stencil.nodes.iter().any(|&v| v >= node_count) {
+                        return Err(SolverError::Basis {
+                            point: p,
+                            position: x.iter().copied().collect(),
+                            reason: format!("basis returned {m} nodes (max {stride}) or a node outside the mesh"),
+                        });
+                    }
+                    for a in 0..m {
+                        nodes[a] = stencil.nodes[a] as u32;
+                        values[a] = stencil.values[a];
+                        grads[a] = stencil.gradients[a];
+                    }
+                    *count = m as u32;
+                    Ok(())
+                },
+            )
+    }
+
+    /// Stage 2: active nodes, dofs, prescribed increments, adjacency,
+    /// sparsity pattern and the symbolic factorisation.
+    pub fn build_system(&mut self, lambda0: f64, lambda1: f64) -> Result<(), SolverError> {
+        let node_count = self.mesh.node_count();
+        let sys = &mut self.system;
+        sys.number_nodes(node_count);
+        sys.build_adjacency();
+        sys.build_neighbours();
+        let constraints = &self.constraints;
+        sys.build_pattern(|node, i| constraints.prescribed(node, i, lambda0, lambda1));
+        let n_dofs = D * sys.n_active();
+        let it = &mut self.it;
+        it.du.clear();
+        it.du.extend_from_slice(&sys.prescribed);
+        it.f_int.clear();
+        it.f_int.resize(n_dofs, 0.0);
+        it.f_ext.clear();
+        it.f_ext.resize(n_dofs, 0.0);
+        it.values.clear();
+        it.values.resize(sys.row_idx.len(), 0.0);
+        let symmetric = L::SYMMETRIC_TANGENT && !K::COUPLES_POINTS;
+        self.linear = Some(
+            LinearSolver::new(sys.n_free, sys.col_ptr.clone(), sys.row_idx.clone(), symmetric)
+                .map_err(|e| SolverError::InvalidInput(format!("sparsity analysis failed: {e}")))?,
+        );
+        Ok(())
+    }
+
+    /// Stage 3: $f^{ext} = \lambda_1\sum_p [S_{vp}]^T(b_p + f_p)$ (eqs. 24,
+    /// 25, 29), constant over the step.
+    pub fn assemble_external_force(&mut self, points: &MaterialPoints<D, L::History, B::Domain>, lambda1: f64) {
+        let sys = &self.system;
+        let f_ext = &mut self.it.f_ext;
+        let mut add = |p: usize, force: &SVector<f64, D>| {
+            for s in sys.slots(p) {
+                let v = sys.nodes[s] as usize;
+                for i in 0..D {
+                    f_ext[D * v + i] += lambda1 * sys.values[s] * force[i];
+                }
+            }
+        };
+        for (p, b) in points.body_force.iter().enumerate() {
+            add(p, b);
+        }
+        for (p, force) in &points.point_force {
+            add(*p, force);
+        }
+    }
+
+    /// Stage 4a: for every point, $\Delta F$ from the grid displacement
+    /// increment (eq. 7), the locking treatment, the constitutive update
+    /// and the weighted stress of the formulation.
+    pub fn update_material_points(
+        &mut self,
+        points: &MaterialPoints<D, L::History, B::Domain>,
+    ) -> Result<(), StepFailure> {
+        let n = points.len();
+        let sys = &self.system;
+        let it = &mut self.it;
+        it.responses.resize(n, None);
+        it.stress_w.resize(n, Matrix3::zeros());
+        if F::MAPS_GRADIENTS {
+            it.mapped.resize(sys.grads.len(), SVector::zeros());
+        }
+        let du = &it.du;
+        let increment = |p: usize| -> Matrix3<f64> {
+            let mut g = SMatrix::<f64, D, D>::identity();
+            for s in sys.slots(p) {
+                let v = sys.nodes[s] as usize;
+                for i in 0..D {
+                    for j in 0..D {
+                        g[(i, j)] += du[D * v + i] * sys.grads[s][j];
+                    }
+                }
+            }
+            embed(&g)
+        };
+        if K::COUPLES_POINTS {
+            it.increments.resize(n, Matrix3::identity());
+            it.increments.par_iter_mut().enumerate().for_each(|(p, m)| *m = increment(p));
+            it.volumes.clear();
+            it.volumes.extend_from_slice(&points.volume);
+            self.locking.prepare(&it.increments, &it.volumes);
+        }
+        let (law, locking) = (&self.law, &self.locking);
+        let stride = sys.stride;
+        let mapped_chunks = it.mapped.par_chunks_mut(stride.max(1));
+        let failure = it
+            .responses
+            .par_iter_mut()
+            .zip(it.stress_w.par_iter_mut())
+            .enumerate()
+            .map(|(p, (response, stress))| {
+                let delta_f = locking.modified_increment(p, &increment(p));
+                let state = MaterialState {
+                    be: points.be[p],
+                    history: points.history[p],
+                };
+                match update(law, &delta_f, &points.f[p], &state) {
+                    Ok(r) => {
+                        *stress = F::stress(&r) * F::volume(&r, points.volume[p]);
+                        *response = Some(r);
+                        None
+                    }
+                    Err(source) => Some(StepFailure::Constitutive { point: p, source }),
+                }
+            })
+            .reduce(|| None, |a, b| match (&a, &b) {
+                (Some(StepFailure::Constitutive { point: pa, .. }), Some(StepFailure::Constitutive { point: pb, .. })) => {
+                    if pa <= pb { a } else { b }
+                }
+                (Some(_), _) => a,
+                _ => b,
+            });
+        if let Some(f) = failure {
+            return Err(f);
+        }
+        if F::MAPS_GRADIENTS {
+            let responses = &it.responses;
+            mapped_chunks.enumerate().for_each(|(p, chunk)| {
+                if let Some(r) = &responses[p] {
+                    for (a, s) in sys.slots(p).enumerate() {
+                        chunk[a] = F::map_gradient(r, &sys.grads[s]);
+                    }
+                }
+            });
+        }
+        Ok(())
+    }
+
+    /// Stage 4b: $f^{int}_v = \sum_p [\nabla S_{vp}]^T\{\text{stress}\}V$
+    /// (eqs. 6, 23, 28), one active node per task.
+    pub fn assemble_internal_force(&mut self) {
+        let grads = if F::MAPS_GRADIENTS { &self.it.mapped } else { &self.system.grads };
+        let sys = &self.system;
+        let stress_w = &self.it.stress_w;
+        self.it.f_int.par_chunks_mut(D).enumerate().for_each(|(v, f)| {
+            f.iter_mut().for_each(|x| *x = 0.0);
+            for &(p, a) in &sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]] {
+                let s = p as usize * sys.stride + a as usize;
+                let sw = &stress_w[p as usize];
+                for i in 0..D {
+                    for j in 0..D {
+                        f[i] += sw[(i, j)] * grads[s][j];
+                    }
+                }
+            }
+        });
+    }
+
+    /// Normalised out-of-balance force (eq. 40):
+    /// $\|f^R\| / \|f^{ext} + f^{react}\|$, the residual taken over free
+    /// dofs and the reactions over prescribed ones.
+    pub fn normalised_residual(&self) -> f64 {
+        let (mut r2, mut d2) = (0.0, 0.0);
+        for (dof, &free) in self.system.free_of_dof.iter().enumerate() {
+            let (fi, fe) = (self.it.f_int[dof], self.it.f_ext[dof]);
+            if free == NONE {
+                d2 += fi * fi;
+            } else {
+                r2 += (fi - fe) * (fi - fe);
+                d2 += fe * fe;
+            }
+        }
+        if r2 == 0.0 {
+            0.0
+        } else if d2 == 0.0 {
+            f64::INFINITY
+        } else {
+            (r2 / d2).sqrt()
+        }
+    }
+
+    /// Sum of reactions per component at prescribed dofs.
+    fn reaction(&self) -> SVector<f64, D> {
+        let mut r = SVector::<f64, D>::zeros();
+        for (dof, &free) in self.system.free_of_dof.iter().enumerate() {
+            if free == NONE {
+                r[dof % D] += self.it.f_int[dof] - self.it.f_ext[dof];
+            }
+        }
+        r
+    }
+
+    /// Stage 4c: the formulation's consistent tangent at every point,
+    /// weighted by its integration volume.
+    pub fn update_tangents(&mut self, points: &MaterialPoints<D, L::History, B::Domain>) -> Result<(), StepFailure> {
+        let law = &self.law;
+        let it = &mut self.it;
+        it.tangent_w.resize(it.responses.len(), Tensor4::zeros());
+        it.tangent_w
+            .par_iter_mut()
+            .zip(it.responses.par_iter())
+            .enumerate()
+            .try_for_each(|(p, (t, r))| {
+                if let Some(r) = r {
+                    let volume = F::volume(r, points.volume[p]);
+                    *t = F::Tangent::tangent(law, r)
+                        .map_err(|source| StepFailure::Constitutive { point: p, source })?
+                        * volume;
+                }
+                Ok(())
+            })
+    }
+
+    /// Stage 4d: the stiffness (eqs. 4/21, 27) in CSC over free dofs, one
+    /// block column (active node) per task; each entry is summed over
+    /// points in ascending order.
+    pub fn assemble_stiffness(&mut self) {
+        let grads = if F::MAPS_GRADIENTS { &self.it.mapped } else { &self.system.grads };
+        let sys = &self.system;
+        let tangent_w = &self.it.tangent_w;
+        let n = sys.n_active();
+        let block = |w: usize, vals: &mut [f64]| {
+            vals.iter_mut().for_each(|x| *x = 0.0);
+            let nbs = &sys.nb[sys.nb_ptr[w]..sys.nb_ptr[w + 1]];
+            let map = &sys.block_map[sys.nb_ptr[w] * D * D..sys.nb_ptr[w + 1] * D * D];
+            for &(p, b) in &sys.adj[sys.adj_ptr[w]..sys.adj_ptr[w + 1]] {
+                let p = p as usize;
+                let t = &tangent_w[p];
+                let gw = &grads[p * sys.stride + b as usize];
+                // q[i][j][k] = Σ_l T_(ij)(kl) g_w,l
+                let mut q = [[[0.0f64; D]; D]; D];
+                for i in 0..D {
+                    for j in 0..D {
+                        for k in 0..D {
+                            let mut acc = 0.0;
+                            for l in 0..D {
+                                acc += t[(idx(i, j), idx(k, l))] * gw[l];
+                            }
+                            q[i][j][k] = acc;
+                        }
+                    }
+                }
+                for s in sys.slots(p) {
+                    let v = sys.nodes[s];
+                    let pos = match nbs.binary_search(&v) {
+                        Ok(pos) => pos,
+                        Err(_) => continue,
+                    };
+                    let gv = &grads[s];
+                    for i in 0..D {
+                        for k in 0..D {
+                            let off = map[(pos * D + i) * D + k];
+                            if off != NONE {
+                                let mut acc = 0.0;
+                                for j in 0..D {
+                                    acc += gv[j] * q[i][j][k];
+                                }
+                                vals[off as usize] += acc;
+                            }
+                        }
+                    }
+                }
+            }
+        };
+        split_blocks(0, n, &mut self.it.values, 0, &sys.block_ptr, &block);
+    }
+
+    /// Stage 4e: solve $K\,\delta d = -f^R$ (eq. 26) and accumulate the
+    /// increment (eq. 30).
+    pub fn solve(&mut self) -> Result<(), String> {
+        let sys = &self.system;
+        let it = &mut self.it;
+        it.rhs.clear();
+        it.rhs.resize(sys.n_free, 0.0);
+        for (dof, &free) in sys.free_of_dof.iter().enumerate() {
+            if free != NONE {
+                it.rhs[free as usize] = it.f_ext[dof] - it.f_int[dof];
+            }
+        }
+        let linear = self.linear.as_mut().ok_or("no linear solver for this step")?;
+        linear.solve(&it.values, &mut it.rhs)?;
+        for (dof, &free) in sys.free_of_dof.iter().enumerate() {
+            if free != NONE {
+                it.du[dof] += it.rhs[free as usize];
+            }
+        }
+        Ok(())
+    }
+
+    /// The converged grid displacement increment interpolated at `x` (a
+    /// point of the configuration at the start of the step) with the
+    /// step's active nodes; used by domain updates that convect corners.
+    fn displacement_at(
+        &self,
+        x: &SVector<f64, D>,
+        domain: &B::Domain,
+        stencil: &mut Stencil<D>,
+    ) -> Result<SVector<f64, D>, DomainError> {
+        self.basis
+            .evaluate(&self.mesh, x, domain, stencil)
+            .map_err(|e| DomainError(e.to_string()))?;
+        let mut u = SVector::<f64, D>::zeros();
+        for (a, &node) in stencil.nodes.iter().enumerate() {
+            let v = self.system.active_of_mesh.get(node).copied().unwrap_or(NONE);
+            if v == NONE {
+                return Err(DomainError(format!("node {node} near {:?} is not active", x.as_slice())));
+            }
+            for i in 0..D {
+                u[i] += stencil.values[a] * self.it.du[D * v as usize + i];
+            }
+        }
+        Ok(u)
+    }
+
+    /// Stage 5: positions (eq. 31), converged deformation and stresses,
+    /// volumes (eq. 22) and domains (the domain updater).
+    pub fn commit(&mut self, points: &mut MaterialPoints<D, L::History, B::Domain>) -> Result<(), SolverError> {
+        let n = points.len();
+        let stencil = std::cell::RefCell::new(Stencil::<D>::with_capacity(B::MAX_NODES));
+        for p in 0..n {
+            let Some(r) = self.it.responses[p].as_ref() else {
+                continue;
+            };
+            let mut du = SVector::<f64, D>::zeros();
+            for s in self.system.slots(p) {
+                let v = self.system.nodes[s] as usize;
+                for i in 0..D {
+                    du[i] += self.system.values[s] * self.it.du[D * v + i];
+                }
+            }
+            let previous = points.position[p];
+            let position = previous + du;
+            let ctx = DomainContext {
+                initial: &points.domain0[p],
+                previous: &points.domain[p],
+                f: &r.f,
+                delta_f: &r.delta_f,
+                position_previous: &previous,
+                position: &position,
+            };
+            let domain = self
+                .updater
+                .update(&ctx, |x| self.displacement_at(x, &points.domain[p], &mut stencil.borrow_mut()))
+                .map_err(|e| SolverError::DomainUpdate { point: p, reason: e.0 })?;
+            points.position[p] = position;
+            points.displacement[p] += du;
+            points.domain[p] = domain;
+            points.f[p] = r.f;
+            points.be[p] = r.state.be;
+            points.history[p] = r.state.history;
+            points.sigma[p] = r.sigma;
+            points.volume[p] = r.j * points.volume0[p];
+        }
+        Ok(())
+    }
+}
+
+/// Runs `f(w, values_of_block_w)` for the block columns `lo..hi` in
+/// parallel, splitting `vals` (which starts at block `lo`, value index
+/// `base`) into disjoint slices at block boundaries.
+fn split_blocks<F>(lo: usize, hi: usize, vals: &mut [f64], base: usize, block_ptr: &[usize], f: &F)
+where
+    F: Fn(usize, &mut [f64]) + Sync,
+{
+    const GRAIN: usize = 64;
+    if hi - lo <= GRAIN {
+        let mut rest = vals;
+        for w in lo..hi {
+            let len = block_ptr[w + 1] - block_ptr[w];
+            let (head, tail) = rest.split_at_mut(len);
+            f(w, head);
+            rest = tail;
+        }
+        return;
+    }
+    let mid = (lo + hi) / 2;
+    let (left, right) = vals.split_at_mut(block_ptr[mid] - base);
+    rayon::join(
+        || split_blocks(lo, mid, left, base, block_ptr, f),
+        || split_blocks(mid, hi, right, block_ptr[mid], block_ptr, f),
+    );
+}

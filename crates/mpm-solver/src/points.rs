@@ -1,0 +1,107 @@
+//! Material point data, one array per quantity (struct of arrays).
+
+use nalgebra::{Matrix3, SVector};
+
+use crate::error::SolverError;
+
+/// The material points of a body. Every vector has one entry per point,
+/// except the optional loads, which are empty when a scene has none (so a
+/// scene without body forces or point loads pays nothing for them).
+#[derive(Debug, Clone)]
+pub struct MaterialPoints<const D: usize, H, Dom> {
+    /// Current position $x_p$.
+    pub position: Vec<SVector<f64, D>>,
+    /// Total displacement since the start of the analysis.
+    pub displacement: Vec<SVector<f64, D>>,
+    /// Mass.
+    pub mass: Vec<f64>,
+    /// Initial volume $V^0_p$.
+    pub volume0: Vec<f64>,
+    /// Converged volume $V^n_p = \det(F_n) V^0_p$ (eq. 22).
+    pub volume: Vec<f64>,
+    /// Converged deformation gradient $F_n$ (3D; plane strain embedded).
+    pub f: Vec<Matrix3<f64>>,
+    /// Converged elastic left Cauchy–Green tensor $b^e_n$.
+    pub be: Vec<Matrix3<f64>>,
+    /// The material law's history.
+    pub history: Vec<H>,
+    /// Converged Cauchy stress (output).
+    pub sigma: Vec<Matrix3<f64>>,
+    /// The basis domain at the start of the analysis.
+    pub domain0: Vec<Dom>,
+    /// The current basis domain.
+    pub domain: Vec<Dom>,
+    /// Body force on each point at load factor 1 (e.g. $m_p g$), applied
+    /// through eq. (24); empty when the scene has none.
+    pub body_force: Vec<SVector<f64, D>>,
+    /// Point loads (point index, force at load factor 1) applied through
+    /// eq. (25); empty when the scene has none.
+    pub point_force: Vec<(usize, SVector<f64, D>)>,
+}
+
+impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
+    /// Undeformed, unstressed points with the given positions, volumes,
+    /// density and domains (one domain per point).
+    pub fn new(
+        position: Vec<SVector<f64, D>>,
+        volume: Vec<f64>,
+        density: f64,
+        domain: Vec<Dom>,
+    ) -> Result<Self, SolverError> {
+        let n = position.len();
+        if volume.len() != n || domain.len() != n {
+            return Err(SolverError::InvalidInput(format!(
+                "{n} positions but {} volumes and {} domains",
+                volume.len(),
+                domain.len()
+            )));
+        }
+        if let Some((p, v)) = volume.iter().enumerate().find(|(_, v)| !(v.is_finite() && **v > 0.0)) {
+            return Err(SolverError::InvalidInput(format!(
+                "material point {p} has volume {v}; volumes must be positive and finite"
+            )));
+        }
+        if let Some(p) = position.iter().position(|x| x.iter().any(|c| !c.is_finite())) {
+            return Err(SolverError::InvalidInput(format!(
+                "material point {p} has a non-finite position {:?}",
+                position[p].as_slice()
+            )));
+        }
+        if !(density.is_finite() && density >= 0.0) {
+            return Err(SolverError::InvalidInput(format!(
+                "density {density} must be non-negative and finite"
+            )));
+        }
+        Ok(Self {
+            displacement: vec![SVector::zeros(); n],
+            mass: volume.iter().map(|v| v * density).collect(),
+            volume0: volume.clone(),
+            volume,
+            f: vec![Matrix3::identity(); n],
+            be: vec![Matrix3::identity(); n],
+            history: vec![H::default(); n],
+            sigma: vec![Matrix3::zeros(); n],
+            domain0: domain.clone(),
+            domain,
+            body_force: Vec::new(),
+            point_force: Vec::new(),
+            position,
+        })
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    /// Whether there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+
+    /// Sets the body force of every point to $m_p\,g$ for the acceleration
+    /// `g` (gravity), reached at load factor 1.
+    pub fn set_gravity(&mut self, g: SVector<f64, D>) {
+        self.body_force = self.mass.iter().map(|m| g * *m).collect();
+    }
+}

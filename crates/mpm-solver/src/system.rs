@@ -1,0 +1,202 @@
+//! The per-load-step system: basis stencils at the start of the step,
+//! active nodes, degrees of freedom, the node-to-point adjacency and the
+//! sparsity pattern of the stiffness. All of it is built once per step (the
+//! active set does not change within a step) into buffers that keep their
+//! capacity between steps.
+
+use nalgebra::SVector;
+
+/// Marker for "none" in the `u32` index maps.
+pub const NONE: u32 = u32::MAX;
+
+/// Stencils of every material point with a fixed stride, node ids in
+/// active numbering after [`StepSystem::number_nodes`].
+#[derive(Debug, Default)]
+pub struct StepSystem<const D: usize> {
+    /// Slots per point.
+    pub stride: usize,
+    /// Node of each stencil entry (mesh id, then active id).
+    pub nodes: Vec<u32>,
+    /// Basis value $S_{vp}$.
+    pub values: Vec<f64>,
+    /// Basis gradient $\partial S_{vp}/\partial\tilde X$.
+    pub grads: Vec<SVector<f64, D>>,
+    /// Number of used slots per point.
+    pub counts: Vec<u32>,
+    /// Active id of each mesh node, or [`NONE`].
+    pub active_of_mesh: Vec<u32>,
+    /// Mesh id of each active node.
+    pub active: Vec<usize>,
+    /// CSR over active nodes: `adj[adj_ptr[v]..adj_ptr[v+1]]` lists the
+    /// (point, slot) pairs whose stencil holds `v`, points ascending.
+    pub adj_ptr: Vec<usize>,
+    /// See `adj_ptr`.
+    pub adj: Vec<(u32, u32)>,
+    /// CSR over active nodes: sorted active neighbours sharing a point.
+    pub nb_ptr: Vec<usize>,
+    /// See `nb_ptr`.
+    pub nb: Vec<u32>,
+    /// Free index of each active dof (`D * v + i`), or [`NONE`] if prescribed.
+    pub free_of_dof: Vec<u32>,
+    /// Prescribed increment of each active dof (zero for free ones).
+    pub prescribed: Vec<f64>,
+    /// Number of free dofs.
+    pub n_free: usize,
+    /// CSC column pointers over free dofs.
+    pub col_ptr: Vec<usize>,
+    /// CSC row indices.
+    pub row_idx: Vec<usize>,
+    /// Start of each active node's block column in the CSC values
+    /// (`n_active + 1` entries; the block columns are contiguous).
+    pub block_ptr: Vec<usize>,
+    /// For block column `w`, entry `(pos, i, k)` at
+    /// `block_map[nb_ptr[w] * D * D + (pos * D + i) * D + k]`: offset in the
+    /// block's value slice of row dof `(nb[pos], i)`, column dof `(w, k)`,
+    /// or [`NONE`] if either is prescribed.
+    pub block_map: Vec<u32>,
+}
+
+impl<const D: usize> StepSystem<D> {
+    /// Number of active nodes.
+    pub fn n_active(&self) -> usize {
+        self.active.len()
+    }
+
+    /// Slot range of point `p`.
+    #[inline]
+    pub fn slots(&self, p: usize) -> std::ops::Range<usize> {
+        let start = p * self.stride;
+        start..start + self.counts[p] as usize
+    }
+
+    /// Marks the active nodes, numbers them by ascending mesh id and
+    /// rewrites the stencils in active numbering.
+    pub fn number_nodes(&mut self, node_count: usize) {
+        self.active_of_mesh.clear();
+        self.active_of_mesh.resize(node_count, NONE);
+        for p in 0..self.counts.len() {
+            for s in self.slots(p) {
+                self.active_of_mesh[self.nodes[s] as usize] = 0;
+            }
+        }
+        self.active.clear();
+        for (mesh_id, slot) in self.active_of_mesh.iter_mut().enumerate() {
+            if *slot != NONE {
+                *slot = self.active.len() as u32;
+                self.active.push(mesh_id);
+            }
+        }
+        for p in 0..self.counts.len() {
+            for s in self.slots(p) {
+                self.nodes[s] = self.active_of_mesh[self.nodes[s] as usize];
+            }
+        }
+    }
+
+    /// Builds the node-to-point adjacency (counting sort: points ascend
+    /// within each node, which fixes the summation order of the assembly
+    /// whatever the number of threads).
+    pub fn build_adjacency(&mut self) {
+        let n = self.n_active();
+        self.adj_ptr.clear();
+        self.adj_ptr.resize(n + 1, 0);
+        for p in 0..self.counts.len() {
+            for s in self.slots(p) {
+                self.adj_ptr[self.nodes[s] as usize + 1] += 1;
+            }
+        }
+        for v in 0..n {
+            self.adj_ptr[v + 1] += self.adj_ptr[v];
+        }
+        self.adj.clear();
+        self.adj.resize(self.adj_ptr[n], (0, 0));
+        let mut fill: Vec<usize> = self.adj_ptr[..n].to_vec();
+        for p in 0..self.counts.len() {
+            let start = p * self.stride;
+            for s in self.slots(p) {
+                let v = self.nodes[s] as usize;
+                self.adj[fill[v]] = (p as u32, (s - start) as u32);
+                fill[v] += 1;
+            }
+        }
+    }
+
+    /// Sorted neighbour lists: nodes sharing at least one point.
+    pub fn build_neighbours(&mut self) {
+        let n = self.n_active();
+        let mut mark = vec![NONE; n];
+        let mut row: Vec<u32> = Vec::with_capacity(64);
+        self.nb_ptr.clear();
+        self.nb_ptr.push(0);
+        self.nb.clear();
+        for w in 0..n {
+            row.clear();
+            for &(p, _) in &self.adj[self.adj_ptr[w]..self.adj_ptr[w + 1]] {
+                for s in self.slots(p as usize) {
+                    let v = self.nodes[s];
+                    if mark[v as usize] != w as u32 {
+                        mark[v as usize] = w as u32;
+                        row.push(v);
+                    }
+                }
+            }
+            row.sort_unstable();
+            self.nb.extend_from_slice(&row);
+            self.nb_ptr.push(self.nb.len());
+        }
+    }
+
+    /// Numbers the free dofs (ascending in `D * v + i`), records prescribed
+    /// increments from `prescribed(mesh_node, component)`, and builds the
+    /// CSC pattern over free dofs together with the block map.
+    pub fn build_pattern(&mut self, prescribed: impl Fn(usize, usize) -> Option<f64>) {
+        let n = self.n_active();
+        self.free_of_dof.clear();
+        self.prescribed.clear();
+        let mut n_free = 0u32;
+        for v in 0..n {
+            for i in 0..D {
+                match prescribed(self.active[v], i) {
+                    Some(du) => {
+                        self.free_of_dof.push(NONE);
+                        self.prescribed.push(du);
+                    }
+                    None => {
+                        self.free_of_dof.push(n_free);
+                        self.prescribed.push(0.0);
+                        n_free += 1;
+                    }
+                }
+            }
+        }
+        self.n_free = n_free as usize;
+        self.col_ptr.clear();
+        self.col_ptr.push(0);
+        self.row_idx.clear();
+        self.block_ptr.clear();
+        self.block_map.clear();
+        for w in 0..n {
+            self.block_ptr.push(self.row_idx.len());
+            let nbs = &self.nb[self.nb_ptr[w]..self.nb_ptr[w + 1]];
+            let base = self.block_map.len();
+            self.block_map.resize(base + nbs.len() * D * D, NONE);
+            for k in 0..D {
+                if self.free_of_dof[D * w + k] == NONE {
+                    continue;
+                }
+                for (pos, &v) in nbs.iter().enumerate() {
+                    for i in 0..D {
+                        let row = self.free_of_dof[D * v as usize + i];
+                        if row != NONE {
+                            let offset = self.row_idx.len() - self.block_ptr[w];
+                            self.block_map[base + (pos * D + i) * D + k] = offset as u32;
+                            self.row_idx.push(row as usize);
+                        }
+                    }
+                }
+                self.col_ptr.push(self.row_idx.len());
+            }
+        }
+        self.block_ptr.push(self.row_idx.len());
+    }
+}
