@@ -58,6 +58,12 @@ pub enum CasesError {
         /// The length given.
         found: usize,
     },
+    /// A data array declared with zero components per tuple.
+    #[error("array `{array}` has zero components per tuple")]
+    ZeroComponents {
+        /// The array name.
+        array: String,
+    },
     /// Points of a dimension VTK cannot hold.
     #[error("points of dimension {dim} cannot be written: VTK takes 1 to 3 coordinates")]
     InvalidDimension {

@@ -238,6 +238,15 @@ fn inconsistent_lengths_are_refused() {
         "{err:?}"
     );
 
+    let empty: [[f64; 0]; 4] = [[]; 4];
+    let err = grid
+        .point_data("e", Values::components(&empty))
+        .unwrap_err();
+    assert!(
+        matches!(&err, CasesError::ZeroComponents { array } if array == "e"),
+        "{err:?}"
+    );
+
     let err = grid.add_cells(CellType::Quad, &[0, 1, 2]).unwrap_err();
     assert!(
         matches!(

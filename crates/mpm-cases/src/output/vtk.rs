@@ -325,7 +325,9 @@ impl<'a> UnstructuredGrid<'a> {
     /// [`CasesError::InvalidName`] for an empty name or one already used on
     /// the points; [`CasesError::LengthMismatch`] unless there is one tuple
     /// per point (and the flat length is a multiple of the component count);
-    /// [`CasesError::NonFinite`] naming the array and point index.
+    /// [`CasesError::ZeroComponents`] for `Float64` data with zero
+    /// components; [`CasesError::NonFinite`] naming the array and point
+    /// index.
     pub fn point_data(&mut self, name: &str, values: Values<'a>) -> Result<&mut Self, CasesError> {
         check_array(name, &values, &self.point_data, "point data array")?;
         check_length(name, &values, self.points.len())?;
@@ -342,8 +344,9 @@ impl<'a> UnstructuredGrid<'a> {
     /// # Errors
     /// [`CasesError::InvalidName`] for an empty name or one already used on
     /// the cells; [`CasesError::LengthMismatch`] if the flat length is not a
-    /// multiple of the component count; [`CasesError::NonFinite`] naming the
-    /// array and cell index.
+    /// multiple of the component count; [`CasesError::ZeroComponents`] for
+    /// `Float64` data with zero components; [`CasesError::NonFinite`] naming
+    /// the array and cell index.
     pub fn cell_data(&mut self, name: &str, values: Values<'a>) -> Result<&mut Self, CasesError> {
         check_array(name, &values, &self.cell_data, "cell data array")?;
         self.cell_data.push(DataArray {
@@ -444,10 +447,15 @@ fn check_array(
     }
     match values {
         Values::Float64 { data, components } => {
-            if *components == 0 || !data.len().is_multiple_of(*components) {
+            if *components == 0 {
+                return Err(CasesError::ZeroComponents {
+                    array: name.to_owned(),
+                });
+            }
+            if !data.len().is_multiple_of(*components) {
                 return Err(CasesError::LengthMismatch {
                     array: name.to_owned(),
-                    expected: data.len().next_multiple_of((*components).max(1)),
+                    expected: data.len().next_multiple_of(*components),
                     found: data.len(),
                 });
             }
