@@ -7,8 +7,12 @@
 //! name or by a scene file, and the `mpm` command-line program that runs
 //! them. The program arrives with the solver.
 
+pub mod body;
+pub mod cases;
 pub mod error;
 pub mod output;
+pub mod run;
 pub mod scene_file;
+pub mod variant;
 
 pub use error::CasesError;

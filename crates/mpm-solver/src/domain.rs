@@ -36,7 +36,11 @@ pub trait DomainUpdater<const D: usize, Dom>: Send + Sync {
     /// grid displacement increment at a point $x$ of the configuration at
     /// the start of the step (eq. 35), for rules that convect corners or
     /// mid-points.
-    fn update<U>(&self, ctx: &DomainContext<'_, D, Dom>, displacement_at: U) -> Result<Dom, DomainError>
+    fn update<U>(
+        &self,
+        ctx: &DomainContext<'_, D, Dom>,
+        displacement_at: U,
+    ) -> Result<Dom, DomainError>
     where
         U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>;
 }
@@ -50,7 +54,11 @@ impl<const D: usize, Dom: Copy> DomainUpdater<D, Dom> for NoUpdate {
     const NAME: &'static str = "none";
 
     #[inline]
-    fn update<U>(&self, ctx: &DomainContext<'_, D, Dom>, _displacement_at: U) -> Result<Dom, DomainError>
+    fn update<U>(
+        &self,
+        ctx: &DomainContext<'_, D, Dom>,
+        _displacement_at: U,
+    ) -> Result<Dom, DomainError>
     where
         U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
     {
@@ -80,7 +88,9 @@ impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for StretchU {
         let u = right_stretch(ctx.f).ok_or_else(|| {
             DomainError("the right stretch tensor of F could not be computed".into())
         })?;
-        Ok(SVector::<f64, D>::from_fn(|i, _| ctx.initial[i] * u[(i, i)]))
+        Ok(SVector::<f64, D>::from_fn(|i, _| {
+            ctx.initial[i] * u[(i, i)]
+        }))
     }
 }
 

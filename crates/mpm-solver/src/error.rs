@@ -10,7 +10,9 @@ use thiserror::Error;
 pub enum StepFailure {
     /// The normalised residual (eq. 40) became non-finite or grew beyond the
     /// divergence limit.
-    #[error("Newton iterations diverged at iteration {iteration} (normalised residual {residual:e})")]
+    #[error(
+        "Newton iterations diverged at iteration {iteration} (normalised residual {residual:e})"
+    )]
     Diverged {
         /// Iteration at which divergence was detected.
         iteration: usize,

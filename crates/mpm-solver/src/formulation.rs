@@ -10,9 +10,7 @@
 //! | [`UpdatedLagrangian`] (§3) | $\sigma$ | $V_p = \Delta J V^n_p$ (eq. 5) | $\nabla_x S = \nabla_{\tilde X}S\,\Delta F^{-1}$ (eq. 8) | $a_{ijkl}$ (eq. A.1) |
 //! | [`PreviouslyConverged`] (§5) | $\tilde P$ (eq. 18) | $V^n_p$ (eq. 22) | $\nabla_{\tilde X}S$ | $\tilde A_{ijkl}$ (eqs. A.3–A.6) |
 
-use mpm_constitutive::{
-    ConsistentTangent, PreviouslyConvergedTangent, Response, SpatialTangent,
-};
+use mpm_constitutive::{ConsistentTangent, PreviouslyConvergedTangent, Response, SpatialTangent};
 use nalgebra::{Matrix3, SVector};
 
 /// A statement of equilibrium (see the module docs).

@@ -182,7 +182,15 @@ where
     C: Constraints<D>,
 {
     /// Composes a solver.
-    pub fn new(basis: B, mesh: B::Mesh, law: L, locking: K, updater: U, constraints: C, options: NewtonOptions) -> Self {
+    pub fn new(
+        basis: B,
+        mesh: B::Mesh,
+        law: L,
+        locking: K,
+        updater: U,
+        constraints: C,
+        options: NewtonOptions,
+    ) -> Self {
         Self {
             basis,
             mesh,
@@ -213,32 +221,43 @@ where
         let mut residuals = Vec::new();
         loop {
             let iteration = residuals.len();
-            self.update_material_points(points).map_err(|cause| StepError::Retry {
-                cause,
-                last_residual: residuals.last().copied().unwrap_or(f64::NAN),
-            })?;
+            self.update_material_points(points)
+                .map_err(|cause| StepError::Retry {
+                    cause,
+                    last_residual: residuals.last().copied().unwrap_or(f64::NAN),
+                })?;
             self.assemble_internal_force();
             let residual = self.normalised_residual();
             residuals.push(residual);
             if residual <= self.options.tolerance {
                 break;
             }
-            if !residual.is_finite() || residual > self.options.divergence_factor * residuals[0].max(self.options.tolerance) {
+            if !residual.is_finite()
+                || residual
+                    > self.options.divergence_factor * residuals[0].max(self.options.tolerance)
+            {
                 return Err(StepError::Retry {
-                    cause: StepFailure::Diverged { iteration, residual },
+                    cause: StepFailure::Diverged {
+                        iteration,
+                        residual,
+                    },
                     last_residual: residual,
                 });
             }
             if iteration >= self.options.max_iterations {
                 return Err(StepError::Retry {
-                    cause: StepFailure::IterationLimit { iterations: iteration, residual },
+                    cause: StepFailure::IterationLimit {
+                        iterations: iteration,
+                        residual,
+                    },
                     last_residual: residual,
                 });
             }
-            self.update_tangents(points).map_err(|cause| StepError::Retry {
-                cause,
-                last_residual: residual,
-            })?;
+            self.update_tangents(points)
+                .map_err(|cause| StepError::Retry {
+                    cause,
+                    last_residual: residual,
+                })?;
             self.assemble_stiffness();
             self.solve().map_err(|reason| StepError::Retry {
                 cause: StepFailure::LinearSolve { reason },
@@ -254,14 +273,20 @@ where
             reaction,
             active_nodes: self.system.n_active(),
             free_dofs: self.system.n_free,
-            factorisation: self.linear.as_ref().and_then(LinearSolver::last_factorisation),
+            factorisation: self
+                .linear
+                .as_ref()
+                .and_then(LinearSolver::last_factorisation),
         })
     }
 
     /// Stage 1: basis values and gradients of every point at the start of
     /// the step, into fixed-stride slots (no allocation per point: each
     /// worker reuses one stencil buffer).
-    pub fn evaluate_basis(&mut self, points: &MaterialPoints<D, L::History, B::Domain>) -> Result<(), SolverError> {
+    pub fn evaluate_basis(
+        &mut self,
+        points: &MaterialPoints<D, L::History, B::Domain>,
+    ) -> Result<(), SolverError> {
         let n = points.len();
         let stride = B::MAX_NODES;
         let sys = &mut self.system;
@@ -298,7 +323,9 @@ where
                         return Err(SolverError::Basis {
                             point: p,
                             position: x.iter().copied().collect(),
-                            reason: format!("basis returned {m} nodes (max {stride}) or a node outside the mesh"),
+                            reason: format!(
+                                "basis returned {m} nodes (max {stride}) or a node outside the mesh"
+                            ),
                         });
                     }
                     for a in 0..m {
@@ -334,15 +361,24 @@ where
         it.values.resize(sys.row_idx.len(), 0.0);
         let symmetric = L::SYMMETRIC_TANGENT && !K::COUPLES_POINTS;
         self.linear = Some(
-            LinearSolver::new(sys.n_free, sys.col_ptr.clone(), sys.row_idx.clone(), symmetric)
-                .map_err(|e| SolverError::InvalidInput(format!("sparsity analysis failed: {e}")))?,
+            LinearSolver::new(
+                sys.n_free,
+                sys.col_ptr.clone(),
+                sys.row_idx.clone(),
+                symmetric,
+            )
+            .map_err(|e| SolverError::InvalidInput(format!("sparsity analysis failed: {e}")))?,
         );
         Ok(())
     }
 
     /// Stage 3: $f^{ext} = \lambda_1\sum_p [S_{vp}]^T(b_p + f_p)$ (eqs. 24,
     /// 25, 29), constant over the step.
-    pub fn assemble_external_force(&mut self, points: &MaterialPoints<D, L::History, B::Domain>, lambda1: f64) {
+    pub fn assemble_external_force(
+        &mut self,
+        points: &MaterialPoints<D, L::History, B::Domain>,
+        lambda1: f64,
+    ) {
         let sys = &self.system;
         let f_ext = &mut self.it.f_ext;
         let mut add = |p: usize, force: &SVector<f64, D>| {
@@ -391,7 +427,10 @@ where
         };
         if K::COUPLES_POINTS {
             it.increments.resize(n, Matrix3::identity());
-            it.increments.par_iter_mut().enumerate().for_each(|(p, m)| *m = increment(p));
+            it.increments
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(p, m)| *m = increment(p));
             it.volumes.clear();
             it.volumes.extend_from_slice(&points.volume);
             self.locking.prepare(&it.increments, &it.volumes);
@@ -419,13 +458,23 @@ where
                     Err(source) => Some(StepFailure::Constitutive { point: p, source }),
                 }
             })
-            .reduce(|| None, |a, b| match (&a, &b) {
-                (Some(StepFailure::Constitutive { point: pa, .. }), Some(StepFailure::Constitutive { point: pb, .. })) => {
-                    if pa <= pb { a } else { b }
-                }
-                (Some(_), _) => a,
-                _ => b,
-            });
+            .reduce(
+                || None,
+                |a, b| match (&a, &b) {
+                    (
+                        Some(StepFailure::Constitutive { point: pa, .. }),
+                        Some(StepFailure::Constitutive { point: pb, .. }),
+                    ) => {
+                        if pa <= pb {
+                            a
+                        } else {
+                            b
+                        }
+                    }
+                    (Some(_), _) => a,
+                    _ => b,
+                },
+            );
         if let Some(f) = failure {
             return Err(f);
         }
@@ -445,21 +494,29 @@ where
     /// Stage 4b: $f^{int}_v = \sum_p [\nabla S_{vp}]^T\{\text{stress}\}V$
     /// (eqs. 6, 23, 28), one active node per task.
     pub fn assemble_internal_force(&mut self) {
-        let grads = if F::MAPS_GRADIENTS { &self.it.mapped } else { &self.system.grads };
+        let grads = if F::MAPS_GRADIENTS {
+            &self.it.mapped
+        } else {
+            &self.system.grads
+        };
         let sys = &self.system;
         let stress_w = &self.it.stress_w;
-        self.it.f_int.par_chunks_mut(D).enumerate().for_each(|(v, f)| {
-            f.iter_mut().for_each(|x| *x = 0.0);
-            for &(p, a) in &sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]] {
-                let s = p as usize * sys.stride + a as usize;
-                let sw = &stress_w[p as usize];
-                for i in 0..D {
-                    for j in 0..D {
-                        f[i] += sw[(i, j)] * grads[s][j];
+        self.it
+            .f_int
+            .par_chunks_mut(D)
+            .enumerate()
+            .for_each(|(v, f)| {
+                f.iter_mut().for_each(|x| *x = 0.0);
+                for &(p, a) in &sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]] {
+                    let s = p as usize * sys.stride + a as usize;
+                    let sw = &stress_w[p as usize];
+                    for i in 0..D {
+                        for j in 0..D {
+                            f[i] += sw[(i, j)] * grads[s][j];
+                        }
                     }
                 }
-            }
-        });
+            });
     }
 
     /// Normalised out-of-balance force (eq. 40):
@@ -498,7 +555,10 @@ where
 
     /// Stage 4c: the formulation's consistent tangent at every point,
     /// weighted by its integration volume.
-    pub fn update_tangents(&mut self, points: &MaterialPoints<D, L::History, B::Domain>) -> Result<(), StepFailure> {
+    pub fn update_tangents(
+        &mut self,
+        points: &MaterialPoints<D, L::History, B::Domain>,
+    ) -> Result<(), StepFailure> {
         let law = &self.law;
         let it = &mut self.it;
         it.tangent_w.resize(it.responses.len(), Tensor4::zeros());
@@ -521,7 +581,11 @@ where
     /// block column (active node) per task; each entry is summed over
     /// points in ascending order.
     pub fn assemble_stiffness(&mut self) {
-        let grads = if F::MAPS_GRADIENTS { &self.it.mapped } else { &self.system.grads };
+        let grads = if F::MAPS_GRADIENTS {
+            &self.it.mapped
+        } else {
+            &self.system.grads
+        };
         let sys = &self.system;
         let tangent_w = &self.it.tangent_w;
         let n = sys.n_active();
@@ -583,7 +647,10 @@ where
                 it.rhs[free as usize] = it.f_ext[dof] - it.f_int[dof];
             }
         }
-        let linear = self.linear.as_mut().ok_or("no linear solver for this step")?;
+        let linear = self
+            .linear
+            .as_mut()
+            .ok_or("no linear solver for this step")?;
         linear.solve(&it.values, &mut it.rhs)?;
         for (dof, &free) in sys.free_of_dof.iter().enumerate() {
             if free != NONE {
@@ -607,9 +674,17 @@ where
             .map_err(|e| DomainError(e.to_string()))?;
         let mut u = SVector::<f64, D>::zeros();
         for (a, &node) in stencil.nodes.iter().enumerate() {
-            let v = self.system.active_of_mesh.get(node).copied().unwrap_or(NONE);
+            let v = self
+                .system
+                .active_of_mesh
+                .get(node)
+                .copied()
+                .unwrap_or(NONE);
             if v == NONE {
-                return Err(DomainError(format!("node {node} near {:?} is not active", x.as_slice())));
+                return Err(DomainError(format!(
+                    "node {node} near {:?} is not active",
+                    x.as_slice()
+                )));
             }
             for i in 0..D {
                 u[i] += stencil.values[a] * self.it.du[D * v as usize + i];
@@ -620,7 +695,10 @@ where
 
     /// Stage 5: positions (eq. 31), converged deformation and stresses,
     /// volumes (eq. 22) and domains (the domain updater).
-    pub fn commit(&mut self, points: &mut MaterialPoints<D, L::History, B::Domain>) -> Result<(), SolverError> {
+    pub fn commit(
+        &mut self,
+        points: &mut MaterialPoints<D, L::History, B::Domain>,
+    ) -> Result<(), SolverError> {
         let n = points.len();
         let stencil = std::cell::RefCell::new(Stencil::<D>::with_capacity(B::MAX_NODES));
         for p in 0..n {
@@ -646,8 +724,13 @@ where
             };
             let domain = self
                 .updater
-                .update(&ctx, |x| self.displacement_at(x, &points.domain[p], &mut stencil.borrow_mut()))
-                .map_err(|e| SolverError::DomainUpdate { point: p, reason: e.0 })?;
+                .update(&ctx, |x| {
+                    self.displacement_at(x, &points.domain[p], &mut stencil.borrow_mut())
+                })
+                .map_err(|e| SolverError::DomainUpdate {
+                    point: p,
+                    reason: e.0,
+                })?;
             points.position[p] = position;
             points.displacement[p] += du;
             points.domain[p] = domain;

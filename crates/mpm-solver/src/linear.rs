@@ -9,6 +9,13 @@
 //! law is not symmetric, the solver switches to sparse LU for the rest of
 //! the step. Both symbolic factorisations are computed at most once per
 //! step, when the sparsity pattern is built.
+//!
+//! The factorisations run sequentially (`faer::Par::Seq`): faer's parallel
+//! supernodal factorisation may apply updates in an order that depends on
+//! thread timing, and in path-dependent problems (plastic collapse) those
+//! last-bit differences grow into visibly different results. Results must
+//! not depend on the run or the number of threads; the material-point loops
+//! carry the parallelism instead.
 
 use faer::Side;
 use faer::linalg::solvers::Solve;
@@ -38,10 +45,19 @@ impl LinearSolver {
     /// Analyses the pattern (`col_ptr`, `row_idx`: CSC, rows sorted) of an
     /// `n × n` matrix. `symmetric` says whether the values will be
     /// symmetric, which enables Cholesky.
-    pub fn new(n: usize, col_ptr: Vec<usize>, row_idx: Vec<usize>, symmetric: bool) -> Result<Self, String> {
+    pub fn new(
+        n: usize,
+        col_ptr: Vec<usize>,
+        row_idx: Vec<usize>,
+        symmetric: bool,
+    ) -> Result<Self, String> {
+        faer::set_global_parallelism(faer::Par::Seq);
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let llt = if symmetric {
-            Some(SymbolicLlt::try_new(pattern.as_ref(), Side::Lower).map_err(|e| format!("{e:?}"))?)
+            Some(
+                SymbolicLlt::try_new(pattern.as_ref(), Side::Lower)
+                    .map_err(|e| format!("{e:?}"))?,
+            )
         } else {
             None
         };
@@ -83,7 +99,8 @@ impl LinearSolver {
             }
         }
         if self.lu.is_none() {
-            self.lu = Some(SymbolicLu::try_new(self.pattern.as_ref()).map_err(|e| format!("{e:?}"))?);
+            self.lu =
+                Some(SymbolicLu::try_new(self.pattern.as_ref()).map_err(|e| format!("{e:?}"))?);
         }
         let symbolic = self.lu.clone().ok_or("symbolic LU missing")?;
         let lu = Lu::try_new_with_symbolic(symbolic, k).map_err(|e| format!("sparse LU: {e:?}"))?;
@@ -97,7 +114,9 @@ fn finite(x: &[f64], f: Factorisation) -> Result<Factorisation, String> {
     if x.iter().all(|v| v.is_finite()) {
         Ok(f)
     } else {
-        Err(format!("{f:?} solve produced non-finite values (singular stiffness)"))
+        Err(format!(
+            "{f:?} solve produced non-finite values (singular stiffness)"
+        ))
     }
 }
 
@@ -144,7 +163,10 @@ mod tests {
         assert_eq!(s.solve(&val, &mut x), Ok(Factorisation::Cholesky));
         assert!(residual(&ptr, &idx, &val, &x, &b) < 1e-10);
         // Indefinite symmetric: Cholesky fails, LU takes over.
-        let neg: Vec<f64> = val.iter().map(|v| if *v == 2.0 { -0.5 } else { *v }).collect();
+        let neg: Vec<f64> = val
+            .iter()
+            .map(|v| if *v == 2.0 { -0.5 } else { *v })
+            .collect();
         let mut x = b.clone();
         assert_eq!(s.solve(&neg, &mut x), Ok(Factorisation::Lu));
         assert!(residual(&ptr, &idx, &neg, &x, &b) < 1e-8);

@@ -56,12 +56,19 @@ impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
                 domain.len()
             )));
         }
-        if let Some((p, v)) = volume.iter().enumerate().find(|(_, v)| !(v.is_finite() && **v > 0.0)) {
+        if let Some((p, v)) = volume
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+        {
             return Err(SolverError::InvalidInput(format!(
                 "material point {p} has volume {v}; volumes must be positive and finite"
             )));
         }
-        if let Some(p) = position.iter().position(|x| x.iter().any(|c| !c.is_finite())) {
+        if let Some(p) = position
+            .iter()
+            .position(|x| x.iter().any(|c| !c.is_finite()))
+        {
             return Err(SolverError::InvalidInput(format!(
                 "material point {p} has a non-finite position {:?}",
                 position[p].as_slice()

@@ -71,9 +71,16 @@ where
         mut observer: O,
     ) -> Result<RunSummary, SolverError>
     where
-        O: FnMut(usize, &StepReport<D>, &MaterialPoints<D, L::History, B::Domain>) -> Result<(), SolverError>,
+        O: FnMut(
+            usize,
+            &StepReport<D>,
+            &MaterialPoints<D, L::History, B::Domain>,
+        ) -> Result<(), SolverError>,
     {
-        if !(stepping.min > 0.0 && stepping.min <= stepping.initial && stepping.initial <= stepping.max) {
+        if !(stepping.min > 0.0
+            && stepping.min <= stepping.initial
+            && stepping.initial <= stepping.max)
+        {
             return Err(SolverError::InvalidInput(format!(
                 "load stepping needs 0 < min <= initial <= max, got {stepping:?}"
             )));
@@ -93,7 +100,10 @@ where
                     increment = (2.0 * increment).min(stepping.max);
                 }
                 Err(StepError::Fatal(e)) => return Err(e),
-                Err(StepError::Retry { cause, last_residual }) => {
+                Err(StepError::Retry {
+                    cause,
+                    last_residual,
+                }) => {
                     summary.cut_steps += 1;
                     let tried = target - lambda;
                     increment = 0.5 * tried;

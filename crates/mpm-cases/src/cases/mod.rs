@@ -1,0 +1,4 @@
+//! The benchmark cases, each with its reference solution.
+
+pub mod collapse;
+pub mod column;

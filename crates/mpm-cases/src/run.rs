@@ -1,0 +1,196 @@
+//! Running one body on a regular grid with a composed implicit solver.
+
+use std::time::Instant;
+
+use mpm_constitutive::{LogStrainLaw, VonMisesHistory};
+use mpm_mesh::RegularGrid;
+use mpm_solver::{
+    Constraints, DomainUpdater, Formulation, ImplicitSolver, LoadStepping, MaterialPoints,
+    NewtonOptions, NoLocking, RunSummary, SolverError, StepReport,
+};
+use nalgebra::SVector;
+
+use crate::body::{Body, InitialDomain};
+
+/// Output quantities of a law's history.
+pub trait HistoryOutput {
+    /// Equivalent plastic strain (zero for elastic laws).
+    fn equivalent_plastic_strain(&self) -> f64;
+}
+
+impl HistoryOutput for () {
+    fn equivalent_plastic_strain(&self) -> f64 {
+        0.0
+    }
+}
+
+impl HistoryOutput for VonMisesHistory {
+    fn equivalent_plastic_strain(&self) -> f64 {
+        VonMisesHistory::equivalent_plastic_strain(self)
+    }
+}
+
+/// A plain copy of the material point state after a step, for output and
+/// error norms (no solver types).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Snapshot {
+    /// Load factor.
+    pub load_factor: f64,
+    /// Positions, padded to 3D.
+    pub position: Vec<[f64; 3]>,
+    /// Total displacement, padded to 3D.
+    pub displacement: Vec<[f64; 3]>,
+    /// Cauchy stress, row-major 3×3.
+    pub sigma: Vec<[f64; 9]>,
+    /// Deformation gradient, row-major 3×3.
+    pub f: Vec<[f64; 9]>,
+    /// Volume.
+    pub volume: Vec<f64>,
+    /// Equivalent plastic strain.
+    pub plastic_strain: Vec<f64>,
+}
+
+impl Snapshot {
+    /// Copies the state of `points`.
+    pub fn of<const D: usize, H: HistoryOutput, Dom>(
+        points: &MaterialPoints<D, H, Dom>,
+        load_factor: f64,
+    ) -> Self {
+        let pad = |x: &SVector<f64, D>| {
+            let mut out = [0.0; 3];
+            for i in 0..D.min(3) {
+                out[i] = x[i];
+            }
+            out
+        };
+        let flat = |m: &nalgebra::Matrix3<f64>| {
+            let mut out = [0.0; 9];
+            for i in 0..3 {
+                for j in 0..3 {
+                    out[3 * i + j] = m[(i, j)];
+                }
+            }
+            out
+        };
+        Self {
+            load_factor,
+            position: points.position.iter().map(pad).collect(),
+            displacement: points.displacement.iter().map(pad).collect(),
+            sigma: points.sigma.iter().map(flat).collect(),
+            f: points.f.iter().map(flat).collect(),
+            volume: points.volume.clone(),
+            plastic_strain: points
+                .history
+                .iter()
+                .map(HistoryOutput::equivalent_plastic_strain)
+                .collect(),
+        }
+    }
+}
+
+/// Loads on a body.
+#[derive(Debug, Clone, Default)]
+pub struct Loads<const D: usize> {
+    /// Gravitational acceleration reached at load factor 1.
+    pub gravity: Option<SVector<f64, D>>,
+    /// Point loads (point index, force at load factor 1).
+    pub point_forces: Vec<(usize, SVector<f64, D>)>,
+}
+
+/// Everything a run produced.
+#[derive(Debug, Clone)]
+pub struct RunOutput<const D: usize> {
+    /// The final state.
+    pub last: Snapshot,
+    /// Reports of the converged steps.
+    pub reports: Vec<StepReport<D>>,
+    /// Step and iteration counts.
+    pub summary: RunSummary,
+    /// Solver wall time (observer time excluded), seconds.
+    pub wall_time_s: f64,
+}
+
+/// A body, a grid, a law, loads and constraints: one quasi-static analysis.
+#[derive(Debug, Clone)]
+pub struct Setup<'a, const D: usize, L, C> {
+    /// The background grid.
+    pub grid: RegularGrid<D>,
+    /// The material points' layout.
+    pub body: &'a Body<D>,
+    /// Density.
+    pub density: f64,
+    /// The material.
+    pub law: L,
+    /// Loads.
+    pub loads: Loads<D>,
+    /// Dirichlet conditions.
+    pub constraints: C,
+    /// Load stepping.
+    pub stepping: LoadStepping,
+    /// Newton controls.
+    pub newton: NewtonOptions,
+}
+
+/// Runs `setup` with basis `B`, formulation `F` and updater `U`; `observer`
+/// sees each converged step's report and state (its time is excluded from
+/// `wall_time_s`).
+pub fn simulate<const D: usize, B, F, U, L, C, O>(
+    setup: Setup<'_, D, L, C>,
+    basis: B,
+    updater: U,
+    mut observer: O,
+) -> Result<RunOutput<D>, SolverError>
+where
+    B: InitialDomain<D, Mesh = RegularGrid<D>>,
+    F: Formulation,
+    U: DomainUpdater<D, B::Domain>,
+    L: LogStrainLaw,
+    L::History: HistoryOutput,
+    C: Constraints<D>,
+    O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
+{
+    let body = setup.body;
+    let domains = body
+        .position
+        .iter()
+        .zip(&body.half_lengths)
+        .map(|(x, l)| B::initial_domain(x, l))
+        .collect();
+    let mut points: MaterialPoints<D, L::History, B::Domain> = MaterialPoints::new(
+        body.position.clone(),
+        body.volume.clone(),
+        setup.density,
+        domains,
+    )?;
+    if let Some(g) = setup.loads.gravity {
+        points.set_gravity(g);
+    }
+    points.point_force = setup.loads.point_forces.clone();
+    let mut solver: ImplicitSolver<D, B, F, L, NoLocking, U, C> = ImplicitSolver::new(
+        basis,
+        setup.grid,
+        setup.law,
+        NoLocking,
+        updater,
+        setup.constraints,
+        setup.newton,
+    );
+    let mut reports = Vec::new();
+    let mut observer_time = 0.0;
+    let start = Instant::now();
+    let summary = solver.run(&mut points, &setup.stepping, |step, report, pts| {
+        let t = Instant::now();
+        reports.push(report.clone());
+        let snapshot = Snapshot::of(pts, report.lambda1);
+        observer(step, report, &snapshot)?;
+        observer_time += t.elapsed().as_secs_f64();
+        Ok(())
+    })?;
+    let wall_time_s = start.elapsed().as_secs_f64() - observer_time;
+    Ok(RunOutput {
+        last: Snapshot::of(&points, 1.0),
+        reports,
+        summary,
+        wall_time_s,
+    })
+}

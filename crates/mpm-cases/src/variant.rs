@@ -1,0 +1,202 @@
+//! The MPM variant of a run — basis, formulation, locking treatment and
+//! domain update — chosen at run time by name and dispatched to a fully
+//! monomorphised solver.
+
+use std::fmt;
+use std::str::FromStr;
+
+use mpm_basis::{Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
+use mpm_mesh::RegularGrid;
+use mpm_solver::{
+    DomainUpdater, Formulation, NoUpdate, PreviouslyConverged, StretchU, UpdatedLagrangian,
+};
+use serde::{Deserialize, Serialize};
+
+use crate::body::InitialDomain;
+
+macro_rules! named_enum {
+    ($(#[$doc:meta])* $name:ident { $($(#[$vdoc:meta])* $variant:ident => $text:literal),+ $(,)? }) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+        pub enum $name {
+            $($(#[$vdoc])* #[serde(rename = $text)] $variant),+
+        }
+
+        impl $name {
+            /// Every value, in declaration order.
+            pub const ALL: &'static [$name] = &[$($name::$variant),+];
+
+            /// The name used in scene files and `--set`.
+            pub fn name(self) -> &'static str {
+                match self { $($name::$variant => $text),+ }
+            }
+        }
+
+        impl fmt::Display for $name {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl FromStr for $name {
+            type Err = String;
+            fn from_str(s: &str) -> Result<Self, String> {
+                match s {
+                    $($text => Ok($name::$variant),)+
+                    other => Err(format!(
+                        "unknown {} `{other}`, expected one of: {}",
+                        stringify!($name),
+                        [$($text),+].join(", ")
+                    )),
+                }
+            }
+        }
+    };
+}
+
+named_enum!(
+    /// Basis functions (mpm-basis).
+    BasisKind {
+        /// Standard MPM (bi/trilinear).
+        Linear => "linear",
+        /// Uniform GIMP.
+        Gimp => "gimp",
+        /// CPDI2.
+        Cpdi2 => "cpdi2",
+        /// Quadratic B-spline.
+        BSpline2 => "bspline2",
+    }
+);
+
+named_enum!(
+    /// Statement of equilibrium (Coombs 2020 §3, §5).
+    FormulationKind {
+        /// Updated Lagrangian.
+        Ul => "ul",
+        /// Previously converged.
+        Pc => "pc",
+    }
+);
+
+named_enum!(
+    /// GIMP domain update rules (Coombs 2020 §6.4).
+    DomainUpdateKind {
+        /// No update.
+        None => "none",
+        /// Eq. (32).
+        DetF => "det_f",
+        /// Eq. (33).
+        DiagF => "diag_f",
+        /// Eq. (34).
+        Stretch => "stretch",
+        /// Eqs. (35)–(37).
+        CornerMidpoint => "corner_midpoint",
+        /// Eq. (38).
+        VolumeCorrectedDiagF => "volume_corrected_diag_f",
+        /// Eq. (39).
+        IncrementalVolumeCorrectedDiagF => "incremental_volume_corrected_diag_f",
+    }
+);
+
+named_enum!(
+    /// Locking treatments.
+    LockingKind {
+        /// Standard: none.
+        None => "none",
+    }
+);
+
+/// A complete MPM variant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Variant {
+    /// Basis.
+    pub basis: BasisKind,
+    /// Formulation.
+    pub formulation: FormulationKind,
+    /// Locking treatment.
+    pub locking: LockingKind,
+    /// Domain update.
+    pub domain_update: DomainUpdateKind,
+}
+
+impl Default for Variant {
+    fn default() -> Self {
+        Self {
+            basis: BasisKind::Linear,
+            formulation: FormulationKind::Pc,
+            locking: LockingKind::None,
+            domain_update: DomainUpdateKind::None,
+        }
+    }
+}
+
+/// A computation generic over the variant's types; [`dispatch`] calls it
+/// with the concrete types named by a [`Variant`].
+pub trait VariantVisitor<const D: usize> {
+    /// What the computation returns.
+    type Output;
+
+    /// Runs with basis `B`, formulation `F` and domain updater `U`.
+    fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
+    where
+        B: InitialDomain<D, Mesh = RegularGrid<D>>,
+        F: Formulation,
+        U: DomainUpdater<D, B::Domain>;
+}
+
+/// Calls `visitor` with the types of `variant`, or says why the
+/// combination is not available.
+pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
+    variant: &Variant,
+    visitor: V,
+) -> Result<V::Output, String> {
+    fn with_formulation<const D: usize, V, B, U>(
+        f: FormulationKind,
+        v: V,
+        basis: B,
+        updater: U,
+    ) -> V::Output
+    where
+        V: VariantVisitor<D>,
+        B: InitialDomain<D, Mesh = RegularGrid<D>>,
+        U: DomainUpdater<D, B::Domain>,
+    {
+        match f {
+            FormulationKind::Ul => v.visit::<B, UpdatedLagrangian, U>(basis, updater),
+            FormulationKind::Pc => v.visit::<B, PreviouslyConverged, U>(basis, updater),
+        }
+    }
+    let f = variant.formulation;
+    let no_domain = |name: &str| {
+        if variant.domain_update == DomainUpdateKind::None {
+            Ok(())
+        } else {
+            Err(format!(
+                "domain_update = {} needs basis = gimp ({name} has no domain to update)",
+                variant.domain_update
+            ))
+        }
+    };
+    match variant.basis {
+        BasisKind::Linear => {
+            no_domain("linear")?;
+            Ok(with_formulation(f, visitor, LinearMpm, NoUpdate))
+        }
+        BasisKind::BSpline2 => {
+            no_domain("bspline2")?;
+            Ok(with_formulation(f, visitor, QuadraticBSpline, NoUpdate))
+        }
+        BasisKind::Cpdi2 => {
+            no_domain("cpdi2 (its corners are convected)")?;
+            let _ = Cpdi2;
+            Err("basis = cpdi2 needs corner convection in the implicit solver, which arrives with the GIMP/CPDI2 domain-update issue".into())
+        }
+        BasisKind::Gimp => match variant.domain_update {
+            DomainUpdateKind::None => Ok(with_formulation(f, visitor, Gimp, NoUpdate)),
+            DomainUpdateKind::Stretch => Ok(with_formulation(f, visitor, Gimp, StretchU)),
+            other => Err(format!(
+                "domain_update = {other} is not implemented yet (it arrives with the GIMP domain-update issue)"
+            )),
+        },
+    }
+}
