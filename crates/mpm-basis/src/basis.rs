@@ -1,0 +1,46 @@
+//! The plug-point trait for basis functions.
+
+use std::fmt::Debug;
+
+use nalgebra::SVector;
+
+use crate::{BasisError, Stencil};
+
+/// A material point basis: for one material point, the supporting nodes
+/// $v$, the values $S_{vp}$ and the gradients
+/// $\partial S_{vp}/\partial\tilde X$ with respect to the background mesh
+/// coordinates (Coombs et al. 2020, eqs. 2 and 19).
+///
+/// Implementations write into a [`Stencil`] the caller owns (fenris
+/// "populate" style), so the solver's loops over material points allocate
+/// nothing. The mesh and the per-point domain are associated types: the
+/// four bases of this crate live on [`mpm_mesh::RegularGrid`]; a linear
+/// basis on simplex meshes will use its own mesh type.
+pub trait BasisFunction<const D: usize>: Send + Sync {
+    /// Background mesh the basis lives on.
+    type Mesh: Sync;
+    /// Per-point domain: `()` for standard MPM and B-splines, the
+    /// half-lengths for GIMP, the corners for CPDI2.
+    type Domain: Copy + Send + Sync + Debug;
+    /// Largest number of supporting nodes of one point.
+    const MAX_NODES: usize;
+
+    /// Clear `out` and write the node ids, values and gradients of the point
+    /// at `position` with domain `domain`.
+    ///
+    /// # Errors
+    /// A [`BasisError`] naming the point when it (or its domain or
+    /// stencil) cannot be evaluated on `mesh`; `out` is then left empty.
+    fn evaluate(
+        &self,
+        mesh: &Self::Mesh,
+        position: &SVector<f64, D>,
+        domain: &Self::Domain,
+        out: &mut Stencil<D>,
+    ) -> Result<(), BasisError>;
+
+    /// An empty stencil with room for [`BasisFunction::MAX_NODES`] nodes.
+    fn new_stencil(&self) -> Stencil<D> {
+        Stencil::with_capacity(Self::MAX_NODES)
+    }
+}
