@@ -193,8 +193,25 @@ impl<const D: usize> BasisFunction<D> for Cpdi2 {
             })?;
             locations[c] = Some(location);
         }
+        // Merging the corners' contributions: when all corner cells lie in
+        // a window of at most WINDOW nodes per axis (domains spanning up to
+        // two cells), a node's stencil slot is found by a table lookup on
+        // its index relative to the window; larger domains fall back to a
+        // linear search of the stencil.
+        const WINDOW: usize = 4;
+        let mut lowest = [usize::MAX; D];
+        let mut highest = [0usize; D];
+        for location in locations.iter().take(n).flatten() {
+            for i in 0..D {
+                lowest[i] = lowest[i].min(location.cell[i]);
+                highest[i] = highest[i].max(location.cell[i]);
+            }
+        }
+        let windowed = (0..D).all(|i| highest[i] - lowest[i] + 2 <= WINDOW);
+        let mut slots = [usize::MAX; WINDOW * WINDOW * WINDOW];
         for (c, location) in locations.iter().take(n).enumerate() {
             let Some(location) = location else { continue };
+            let (w, wg) = (weights.value_weights[c], weights.gradient_weights[c]);
             // N_v at the corner: the multilinear functions of its cell.
             for b in 0..1usize << D {
                 let mut index = location.cell;
@@ -218,11 +235,23 @@ impl<const D: usize> BasisFunction<D> for Cpdi2 {
                         return Err(e.into());
                     }
                 };
-                out.accumulate(
-                    node,
-                    weights.value_weights[c] * value,
-                    weights.gradient_weights[c] * value,
-                );
+                if windowed {
+                    let key = (0..D)
+                        .rev()
+                        .fold(0, |k, i| k * WINDOW + index[i] - lowest[i]);
+                    match slots[key] {
+                        usize::MAX => {
+                            slots[key] = out.len();
+                            out.push(node, w * value, wg * value);
+                        }
+                        slot => {
+                            out.values[slot] += w * value;
+                            out.gradients[slot] += wg * value;
+                        }
+                    }
+                } else {
+                    out.accumulate(node, w * value, wg * value);
+                }
             }
         }
         Ok(())
