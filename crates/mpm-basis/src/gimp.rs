@@ -21,11 +21,11 @@ use crate::{BasisError, BasisFunction, Stencil};
 /// regions, valid for $0 < \lambda \le 1/2$):
 ///
 /// $$S(\delta;\lambda) = \begin{cases}
-/// \dfrac{(1+\lambda+\delta)^2}{4\lambda} & -1-\lambda < \delta \le -1+\lambda\\[4pt]
-/// 1 + \delta & -1+\lambda < \delta \le -\lambda\\[4pt]
-/// 1 - \dfrac{\delta^2+\lambda^2}{2\lambda} & -\lambda < \delta \le \lambda\\[4pt]
-/// 1 - \delta & \lambda < \delta \le 1-\lambda\\[4pt]
-/// \dfrac{(1+\lambda-\delta)^2}{4\lambda} & 1-\lambda < \delta < 1+\lambda\\[4pt]
+/// \dfrac{(1+\lambda+\delta)^2}{4\lambda} & -1-\lambda < \delta \le -1+\lambda\\
+/// 1 + \delta & -1+\lambda < \delta \le -\lambda\\
+/// 1 - \dfrac{\delta^2+\lambda^2}{2\lambda} & -\lambda < \delta \le \lambda\\
+/// 1 - \delta & \lambda < \delta \le 1-\lambda\\
+/// \dfrac{(1+\lambda-\delta)^2}{4\lambda} & 1-\lambda < \delta < 1+\lambda\\
 /// 0 & \text{otherwise,}
 /// \end{cases}$$
 ///

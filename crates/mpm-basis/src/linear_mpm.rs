@@ -16,7 +16,7 @@ use crate::{BasisError, BasisFunction, Stencil};
 /// $$N_v(\mathbf x) = \prod_{i<D} \hat N\!\left(\frac{x_i - X_{v,i}}{h_i}\right),
 /// \qquad \hat N(r) = \max(0, 1 - |r|),$$
 ///
-/// built per axis from the local coordinate $t_i\in[0,1]$ of the point in
+/// built per axis from the local coordinate $t_i\in[0, 1]$ of the point in
 /// its cell $k$: factors $(1-t_i, -1/h_i)$ at node $k_i$ and $(t_i, 1/h_i)$
 /// at node $k_i+1$.
 ///

@@ -9,12 +9,12 @@ use crate::{BasisError, BasisFunction, Stencil};
 /// Uniform quadratic B-spline basis (Steffen et al. 2008; MPoint theory
 /// notes eqs. 24–27), one spline centred at every grid node:
 ///
-/// $$N(r) = \begin{cases} \tfrac34 - r^2 & |r| < \tfrac12\\[2pt]
-/// \tfrac12\left(\tfrac32 - |r|\right)^2 & \tfrac12 \le |r| < \tfrac32\\[2pt]
+/// $$N(r) = \begin{cases} \tfrac34 - r^2 & |r| < \tfrac12\\
+/// \tfrac12\left(\tfrac32 - |r|\right)^2 & \tfrac12 \le |r| < \tfrac32\\
 /// 0 & \tfrac32 \le |r|\end{cases}\qquad\text{(24)}$$
 ///
-/// $$N'(r) = \begin{cases} -2r & |r| < \tfrac12\\[2pt]
-/// \left(|r| - \tfrac32\right)\operatorname{sign} r & \tfrac12 \le |r| < \tfrac32\\[2pt]
+/// $$N'(r) = \begin{cases} -2r & |r| < \tfrac12\\
+/// \left(|r| - \tfrac32\right)\operatorname{sign} r & \tfrac12 \le |r| < \tfrac32\\
 /// 0 & \tfrac32 \le |r|\end{cases}\qquad\text{(25)}$$
 ///
 /// with $r_i = (x_{p,i} - X_{v,i})/h_i$, $S_{vp} = \prod_i N(r_i)$ (26) and
