@@ -83,6 +83,10 @@ pub trait InitialDomain<const D: usize>: BasisFunction<D> {
     /// boundary (the B-spline stencil must stay inside the grid).
     const PADDING: usize = 0;
 
+    /// Half-width of a point's support in cells, per axis (an upper bound
+    /// for domain-based bases with domains of at most half a cell).
+    const SUPPORT_RADIUS: f64 = 1.0;
+
     /// The undeformed domain.
     fn initial_domain(position: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> Self::Domain;
 }
@@ -93,17 +97,20 @@ impl<const D: usize> InitialDomain<D> for LinearMpm {
 
 impl<const D: usize> InitialDomain<D> for QuadraticBSpline {
     const PADDING: usize = 1;
+    const SUPPORT_RADIUS: f64 = 1.5;
 
     fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
 }
 
 impl<const D: usize> InitialDomain<D> for Gimp {
+    const SUPPORT_RADIUS: f64 = 1.5;
     fn initial_domain(_: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> SVector<f64, D> {
         *half_lengths
     }
 }
 
 impl<const D: usize> InitialDomain<D> for Cpdi2 {
+    const SUPPORT_RADIUS: f64 = 1.5;
     fn initial_domain(position: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> Corners<D> {
         Corners::rectangle(position, half_lengths)
     }

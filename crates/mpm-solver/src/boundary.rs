@@ -1,8 +1,15 @@
 //! Dirichlet conditions on grid nodes (Coombs 2020 §6.2: imposed directly
 //! on the background mesh as in the finite element method).
 
+use nalgebra::SVector;
+
 /// Prescribed displacement increments of grid degrees of freedom.
 pub trait Constraints<const D: usize>: Send + Sync {
+    /// Called at the start of every load step attempt with the material
+    /// point positions, for conditions that follow the body (e.g. the
+    /// cells holding its boundary points). The default does nothing.
+    fn begin_step(&mut self, _positions: &[SVector<f64, D>]) {}
+
     /// The prescribed displacement increment of component `component` of
     /// mesh node `node` over the load step from load factor `lambda0` to
     /// `lambda1`, or `None` if the degree of freedom is free.

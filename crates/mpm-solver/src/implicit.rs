@@ -40,6 +40,10 @@ use crate::mesh::NodalMesh;
 use crate::points::MaterialPoints;
 use crate::system::{NONE, StepSystem};
 
+/// Halvings of a Newton correction that inverts a material point before
+/// the step fails.
+pub const MAX_BACKTRACKS: usize = 10;
+
 /// Newton–Raphson controls.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonOptions {
@@ -50,6 +54,22 @@ pub struct NewtonOptions {
     /// The step is declared divergent when the normalised residual exceeds
     /// this factor times its value at iteration 0.
     pub divergence_factor: f64,
+    /// Nodes whose support volume $\sum_p S_{vp}V^n_p$ is below this
+    /// fraction of the largest nodal support volume are held fixed over the
+    /// step. Such fringe nodes (a GIMP domain or B-spline stencil barely
+    /// reaching them) add next to no stiffness; left free they make the
+    /// stiffness nearly singular, and the nearly arbitrary increments they
+    /// receive would move the points through $S_{vp}\Delta u_v$ (eq. 31).
+    /// Zero disables the rule.
+    pub weak_node_threshold: f64,
+    /// Start each step's iterations from the previous step's converged
+    /// increment, scaled by the ratio of load increments, at the free
+    /// nodes that were active then (a secant predictor). Off, the free
+    /// nodes start at zero increment, as in Coombs et al. 2020. The
+    /// predictor saves iterations on smooth load paths and keeps Newton on
+    /// the branch of the previous step where the equilibrium path has
+    /// bifurcations (perfect plasticity).
+    pub predictor: bool,
 }
 
 impl Default for NewtonOptions {
@@ -58,6 +78,8 @@ impl Default for NewtonOptions {
             tolerance: 1e-9,
             max_iterations: 30,
             divergence_factor: 1e6,
+            weak_node_threshold: 1e-6,
+            predictor: false,
         }
     }
 }
@@ -168,6 +190,8 @@ where
     system: StepSystem<D>,
     it: Iterate<D, L::History>,
     linear: Option<LinearSolver>,
+    /// The last converged increment per mesh dof and its load increment.
+    previous: Option<(Vec<f64>, f64)>,
     _formulation: PhantomData<F>,
 }
 
@@ -202,6 +226,7 @@ where
             system: StepSystem::default(),
             it: Iterate::default(),
             linear: None,
+            previous: None,
             _formulation: PhantomData,
         }
     }
@@ -216,12 +241,14 @@ where
         lambda1: f64,
     ) -> Result<StepReport<D>, StepError> {
         self.evaluate_basis(points)?;
-        self.build_system(lambda0, lambda1)?;
+        self.constraints.begin_step(&points.position);
+        self.build_system(&points.volume, lambda0, lambda1)?;
+        self.predict(lambda1 - lambda0);
         self.assemble_external_force(points, lambda1);
         let mut residuals = Vec::new();
         loop {
             let iteration = residuals.len();
-            self.update_material_points(points)
+            self.update_material_points_backtracking(points, iteration > 0)
                 .map_err(|cause| StepError::Retry {
                     cause,
                     last_residual: residuals.last().copied().unwrap_or(f64::NAN),
@@ -266,6 +293,7 @@ where
         }
         let reaction = self.reaction();
         self.commit(points)?;
+        self.remember_increment(lambda1 - lambda0);
         Ok(StepReport {
             lambda0,
             lambda1,
@@ -341,14 +369,38 @@ where
 
     /// Stage 2: active nodes, dofs, prescribed increments, adjacency,
     /// sparsity pattern and the symbolic factorisation.
-    pub fn build_system(&mut self, lambda0: f64, lambda1: f64) -> Result<(), SolverError> {
+    pub fn build_system(
+        &mut self,
+        volumes: &[f64],
+        lambda0: f64,
+        lambda1: f64,
+    ) -> Result<(), SolverError> {
         let node_count = self.mesh.node_count();
         let sys = &mut self.system;
         sys.number_nodes(node_count);
         sys.build_adjacency();
         sys.build_neighbours();
+        let support: Vec<f64> = (0..sys.n_active())
+            .map(|v| {
+                sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]]
+                    .iter()
+                    .map(|&(p, a)| {
+                        sys.values[p as usize * sys.stride + a as usize] * volumes[p as usize]
+                    })
+                    .sum()
+            })
+            .collect();
+        let cutoff = self.options.weak_node_threshold * support.iter().copied().fold(0.0, f64::max);
+        let weak: Vec<bool> = support.iter().map(|&w| w < cutoff).collect();
         let constraints = &self.constraints;
-        sys.build_pattern(|node, i| constraints.prescribed(node, i, lambda0, lambda1));
+        let active_of_mesh = std::mem::take(&mut sys.active_of_mesh);
+        sys.build_pattern(|node, i| {
+            let held = weak[active_of_mesh[node] as usize];
+            constraints
+                .prescribed(node, i, lambda0, lambda1)
+                .or(held.then_some(0.0))
+        });
+        sys.active_of_mesh = active_of_mesh;
         let n_dofs = D * sys.n_active();
         let it = &mut self.it;
         it.du.clear();
@@ -370,6 +422,40 @@ where
             .map_err(|e| SolverError::InvalidInput(format!("sparsity analysis failed: {e}")))?,
         );
         Ok(())
+    }
+
+    /// The secant predictor ([`NewtonOptions::predictor`]): free dofs start
+    /// from the previous converged increment scaled to this step.
+    fn predict(&mut self, dlambda: f64) {
+        if !self.options.predictor {
+            return;
+        }
+        let Some((previous, dlambda_prev)) = &self.previous else {
+            return;
+        };
+        let scale = dlambda / dlambda_prev;
+        let sys = &self.system;
+        for (dof, &free) in sys.free_of_dof.iter().enumerate() {
+            if free != NONE {
+                let mesh_dof = D * sys.active[dof / D] + dof % D;
+                self.it.du[dof] = scale * previous[mesh_dof];
+            }
+        }
+    }
+
+    /// Stores the converged increment per mesh dof for the predictor.
+    fn remember_increment(&mut self, dlambda: f64) {
+        if !self.options.predictor {
+            return;
+        }
+        let n = D * self.mesh.node_count();
+        let (mut store, _) = self.previous.take().unwrap_or_default();
+        store.clear();
+        store.resize(n, 0.0);
+        for (dof, du) in self.it.du.iter().enumerate() {
+            store[D * self.system.active[dof / D] + dof % D] = *du;
+        }
+        self.previous = Some((store, dlambda));
     }
 
     /// Stage 3: $f^{ext} = \lambda_1\sum_p [S_{vp}]^T(b_p + f_p)$ (eqs. 24,
@@ -395,6 +481,38 @@ where
         for (p, force) in &points.point_force {
             add(*p, force);
         }
+    }
+
+    /// Stage 4a with backtracking: when a Newton correction inverts a
+    /// material point (det ΔF <= 0 or another constitutive failure), the
+    /// correction is halved, up to [`MAX_BACKTRACKS`] times, before the step
+    /// is declared failed. Sparsely populated cells give nodes with little
+    /// stiffness whose corrections can overshoot; backtracking keeps Newton
+    /// on track without changing the converged solution.
+    fn update_material_points_backtracking(
+        &mut self,
+        points: &MaterialPoints<D, L::History, B::Domain>,
+        after_solve: bool,
+    ) -> Result<(), StepFailure> {
+        let mut result = self.update_material_points(points);
+        let mut backtracks = 0;
+        while let Err(StepFailure::Constitutive { .. }) = result {
+            if !after_solve || backtracks == MAX_BACKTRACKS {
+                break;
+            }
+            backtracks += 1;
+            let sys = &self.system;
+            let it = &mut self.it;
+            for (dof, &free) in sys.free_of_dof.iter().enumerate() {
+                if free != NONE {
+                    let half = 0.5 * it.rhs[free as usize];
+                    it.du[dof] -= half;
+                    it.rhs[free as usize] = half;
+                }
+            }
+            result = self.update_material_points(points);
+        }
+        result
     }
 
     /// Stage 4a: for every point, $\Delta F$ from the grid displacement
