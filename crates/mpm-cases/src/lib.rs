@@ -11,6 +11,7 @@ pub mod body;
 pub mod cases;
 pub mod error;
 pub mod output;
+pub mod params;
 pub mod run;
 pub mod scene_file;
 pub mod variant;

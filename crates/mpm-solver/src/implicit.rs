@@ -101,6 +101,10 @@ pub struct StepReport<const D: usize> {
     pub free_dofs: usize,
     /// Factorisation used by the last solve.
     pub factorisation: Option<Factorisation>,
+    /// Iterations (indices into `residuals`) whose Newton correction was
+    /// shortened by backtracking; the iterations after the last of them are
+    /// plain Newton steps.
+    pub backtracked: Vec<usize>,
 }
 
 impl<const D: usize> StepReport<D> {
@@ -246,13 +250,17 @@ where
         self.predict(lambda1 - lambda0);
         self.assemble_external_force(points, lambda1);
         let mut residuals = Vec::new();
+        let mut backtracked = Vec::new();
         loop {
             let iteration = residuals.len();
-            self.update_material_points_backtracking(points, iteration > 0)
-                .map_err(|cause| StepError::Retry {
-                    cause,
-                    last_residual: residuals.last().copied().unwrap_or(f64::NAN),
-                })?;
+            let shortened = self.update_material_points_backtracking(points, iteration > 0);
+            if matches!(shortened, Ok(true)) {
+                backtracked.push(iteration);
+            }
+            shortened.map_err(|cause| StepError::Retry {
+                cause,
+                last_residual: residuals.last().copied().unwrap_or(f64::NAN),
+            })?;
             self.assemble_internal_force();
             let residual = self.normalised_residual();
             residuals.push(residual);
@@ -305,6 +313,7 @@ where
                 .linear
                 .as_ref()
                 .and_then(LinearSolver::last_factorisation),
+            backtracked,
         })
     }
 
@@ -493,7 +502,7 @@ where
         &mut self,
         points: &MaterialPoints<D, L::History, B::Domain>,
         after_solve: bool,
-    ) -> Result<(), StepFailure> {
+    ) -> Result<bool, StepFailure> {
         let mut result = self.update_material_points(points);
         let mut backtracks = 0;
         while let Err(StepFailure::Constitutive { .. }) = result {
@@ -512,7 +521,7 @@ where
             }
             result = self.update_material_points(points);
         }
-        result
+        result.map(|()| backtracks > 0)
     }
 
     /// Stage 4a: for every point, $\Delta F$ from the grid displacement
@@ -886,4 +895,87 @@ where
         || split_blocks(lo, mid, left, base, block_ptr, f),
         || split_blocks(mid, hi, right, block_ptr[mid], block_ptr, f),
     );
+}
+
+/// Verification helpers: the residual and the assembled stiffness as dense
+/// arrays at a chosen displacement increment, so that tests can compare
+/// the stiffness with finite differences of the residual.
+impl<const D: usize, B, F, L, K, U, C> ImplicitSolver<D, B, F, L, K, U, C>
+where
+    B: BasisFunction<D>,
+    B::Mesh: NodalMesh,
+    F: Formulation,
+    L: LogStrainLaw,
+    K: LockingTreatment,
+    U: DomainUpdater<D, B::Domain>,
+    C: Constraints<D>,
+{
+    /// Prepares the step from `lambda0` to `lambda1` (basis, system,
+    /// external force) without iterating; returns the number of free dofs.
+    pub fn prepare_step(
+        &mut self,
+        points: &MaterialPoints<D, L::History, B::Domain>,
+        lambda0: f64,
+        lambda1: f64,
+    ) -> Result<usize, SolverError> {
+        self.evaluate_basis(points)?;
+        self.constraints.begin_step(&points.position);
+        self.build_system(&points.volume, lambda0, lambda1)?;
+        self.assemble_external_force(points, lambda1);
+        Ok(self.system.n_free)
+    }
+
+    /// The out-of-balance force $f^{int} - f^{ext}$ on the free dofs at the
+    /// free-dof increment `du_free` (prescribed dofs at their prescribed
+    /// increments).
+    pub fn free_residual(
+        &mut self,
+        points: &MaterialPoints<D, L::History, B::Domain>,
+        du_free: &[f64],
+    ) -> Result<Vec<f64>, StepFailure> {
+        self.set_free_increment(du_free);
+        self.update_material_points(points)?;
+        self.assemble_internal_force();
+        let sys = &self.system;
+        let mut r = vec![0.0; sys.n_free];
+        for (dof, &free) in sys.free_of_dof.iter().enumerate() {
+            if free != NONE {
+                r[free as usize] = self.it.f_int[dof] - self.it.f_ext[dof];
+            }
+        }
+        Ok(r)
+    }
+
+    /// The assembled stiffness over free dofs at `du_free`, dense and
+    /// column-major (`n_free × n_free`).
+    pub fn free_stiffness_dense(
+        &mut self,
+        points: &MaterialPoints<D, L::History, B::Domain>,
+        du_free: &[f64],
+    ) -> Result<Vec<f64>, StepFailure> {
+        self.set_free_increment(du_free);
+        self.update_material_points(points)?;
+        self.update_tangents(points)?;
+        self.assemble_stiffness();
+        let sys = &self.system;
+        let n = sys.n_free;
+        let mut k = vec![0.0; n * n];
+        for c in 0..n {
+            for e in sys.col_ptr[c]..sys.col_ptr[c + 1] {
+                k[c * n + sys.row_idx[e]] = self.it.values[e];
+            }
+        }
+        Ok(k)
+    }
+
+    fn set_free_increment(&mut self, du_free: &[f64]) {
+        let sys = &self.system;
+        for (dof, &free) in sys.free_of_dof.iter().enumerate() {
+            self.it.du[dof] = if free == NONE {
+                sys.prescribed[dof]
+            } else {
+                du_free.get(free as usize).copied().unwrap_or(0.0)
+            };
+        }
+    }
 }

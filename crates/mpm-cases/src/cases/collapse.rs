@@ -21,55 +21,36 @@ use mpm_solver::{
     StepReport,
 };
 use nalgebra::SVector;
-use serde::{Deserialize, Serialize};
 
 use crate::body::{Body, InitialDomain};
 use crate::run::{Loads, RunOutput, Setup, Snapshot, simulate};
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
-/// Parameters of the collapse case (defaults: the paper's values).
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct CollapseParams {
-    /// Cell size h (m).
-    pub h: f64,
-    /// Material points per cell per direction.
-    pub points_per_cell: usize,
-    /// Width of the modelled half block (m).
-    pub width: f64,
-    /// Height of the block l₀ (m).
-    pub height: f64,
-    /// Young's modulus (Pa).
-    pub youngs_modulus: f64,
-    /// Poisson's ratio.
-    pub poisson_ratio: f64,
-    /// Deviatoric yield stress ρ_y (Pa), eq. (43).
-    pub yield_stress: f64,
-    /// Body force magnitude (N/m³), acting downwards.
-    pub body_force: f64,
-    /// Number of equal load steps.
-    pub load_steps: usize,
-    /// Newton tolerance on eq. (40).
-    pub tolerance: f64,
-    /// Grid width (m): room for the block to spread.
-    pub grid_width: f64,
-}
-
-impl Default for CollapseParams {
-    fn default() -> Self {
-        Self {
-            h: 1.0,
-            points_per_cell: 3,
-            width: 8.0,
-            height: 8.0,
-            youngs_modulus: 1e6,
-            poisson_ratio: 0.3,
-            yield_stress: 20e3,
-            body_force: 10e3,
-            load_steps: 40,
-            tolerance: 1e-9,
-            grid_width: 20.0,
-        }
+crate::case_params! {
+    /// Parameters of the collapse case (defaults: the paper's values).
+    pub struct CollapseParams {
+        /// Cell size h (m).
+        pub h: f64 = 1.0,
+        /// Material points per cell per direction.
+        pub points_per_cell: usize = 3,
+        /// Width of the modelled half block (m).
+        pub width: f64 = 8.0,
+        /// Height of the block l₀ (m).
+        pub height: f64 = 8.0,
+        /// Young's modulus (Pa).
+        pub youngs_modulus: f64 = 1e6,
+        /// Poisson's ratio.
+        pub poisson_ratio: f64 = 0.3,
+        /// Deviatoric yield stress ρ_y (Pa), eq. (43).
+        pub yield_stress: f64 = 20e3,
+        /// Body force magnitude (N/m³), acting downwards.
+        pub body_force: f64 = 10e3,
+        /// Number of equal load steps.
+        pub load_steps: usize = 40,
+        /// Newton tolerance on eq. (40).
+        pub tolerance: f64 = 1e-9,
+        /// Grid width (m): room for the block to spread.
+        pub grid_width: f64 = 20.0,
     }
 }
 

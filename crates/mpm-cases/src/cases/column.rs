@@ -14,49 +14,32 @@ use mpm_solver::{
     DomainUpdater, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
 };
 use nalgebra::SVector;
-use serde::{Deserialize, Serialize};
 
 use crate::body::{Body, InitialDomain};
 use crate::run::{Loads, RunOutput, Setup, Snapshot, simulate};
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
-/// Parameters of the column case (defaults: the paper's values).
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct ColumnParams {
-    /// Cell size h (m); the column is one cell wide.
-    pub h: f64,
-    /// Material points per cell per direction.
-    pub points_per_cell: usize,
-    /// Initial height l₀ (m).
-    pub height: f64,
-    /// Young's modulus (Pa).
-    pub youngs_modulus: f64,
-    /// Poisson's ratio.
-    pub poisson_ratio: f64,
-    /// Density ϱ₀ (kg/m³).
-    pub density: f64,
-    /// Gravitational acceleration g (m/s²).
-    pub gravity: f64,
-    /// Number of equal load steps.
-    pub load_steps: usize,
-    /// Newton tolerance on eq. (40).
-    pub tolerance: f64,
-}
-
-impl Default for ColumnParams {
-    fn default() -> Self {
-        Self {
-            h: 50.0 / 16.0,
-            points_per_cell: 2,
-            height: 50.0,
-            youngs_modulus: 1e6,
-            poisson_ratio: 0.0,
-            density: 80.0,
-            gravity: 10.0,
-            load_steps: 20,
-            tolerance: 1e-9,
-        }
+crate::case_params! {
+    /// Parameters of the column case (defaults: the paper's values).
+    pub struct ColumnParams {
+        /// Cell size h (m); the column is one cell wide.
+        pub h: f64 = 50.0 / 16.0,
+        /// Material points per cell per direction.
+        pub points_per_cell: usize = 2,
+        /// Initial height l₀ (m).
+        pub height: f64 = 50.0,
+        /// Young's modulus (Pa).
+        pub youngs_modulus: f64 = 1e6,
+        /// Poisson's ratio.
+        pub poisson_ratio: f64 = 0.0,
+        /// Density ϱ₀ (kg/m³).
+        pub density: f64 = 80.0,
+        /// Gravitational acceleration g (m/s²).
+        pub gravity: f64 = 10.0,
+        /// Number of equal load steps.
+        pub load_steps: usize = 20,
+        /// Newton tolerance on eq. (40).
+        pub tolerance: f64 = 1e-9,
     }
 }
 

@@ -44,55 +44,37 @@ use mpm_solver::{
     Constraints, DomainUpdater, Formulation, LoadStepping, NewtonOptions, SolverError, StepReport,
 };
 use nalgebra::{Matrix2, Matrix3, SVector};
-use serde::{Deserialize, Serialize};
 
 use crate::body::{Body, InitialDomain};
 use crate::run::{HistoryOutput, Loads, RunOutput, Setup, Snapshot, simulate};
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
-/// Parameters of the shear case (defaults: the paper's values).
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct ShearParams {
-    /// Cell size h (m).
-    pub h: f64,
-    /// Material points per cell per direction.
-    pub points_per_cell: usize,
-    /// Young's modulus (Pa).
-    pub youngs_modulus: f64,
-    /// Poisson's ratio.
-    pub poisson_ratio: f64,
-    /// Deviatoric yield stress ρ_y (Pa); absent: elastic.
-    pub yield_stress: Option<f64>,
-    /// Final shear displacement of the top face Δl (m) of the unit square.
-    pub shear: f64,
-    /// Number of equal load steps.
-    pub load_steps: usize,
-    /// Newton tolerance on eq. (40).
-    pub tolerance: f64,
-    /// Shift of the grid to the left of the body, as a fraction of h.
-    pub grid_offset: f64,
-    /// Start each step from the previous increment (the solver's secant
-    /// predictor). Needed for the perfectly plastic case: at first yield
-    /// the discrete equations also admit localised solutions, and Newton
-    /// started from zero increments at the free nodes finds one.
-    pub predictor: bool,
-}
-
-impl Default for ShearParams {
-    fn default() -> Self {
-        Self {
-            h: 0.125,
-            points_per_cell: 3,
-            youngs_modulus: 10e3,
-            poisson_ratio: 0.3,
-            yield_stress: None,
-            shear: 6.0,
-            load_steps: 30,
-            tolerance: 1e-9,
-            grid_offset: 0.123_456_789,
-            predictor: true,
-        }
+crate::case_params! {
+    /// Parameters of the shear case (defaults: the paper's values).
+    pub struct ShearParams {
+        /// Cell size h (m).
+        pub h: f64 = 0.125,
+        /// Material points per cell per direction.
+        pub points_per_cell: usize = 3,
+        /// Young's modulus (Pa).
+        pub youngs_modulus: f64 = 10e3,
+        /// Poisson's ratio.
+        pub poisson_ratio: f64 = 0.3,
+        /// Deviatoric yield stress ρ_y (Pa); absent: elastic.
+        pub yield_stress: Option<f64> = None,
+        /// Final shear displacement of the top face Δl (m) of the unit square.
+        pub shear: f64 = 6.0,
+        /// Number of equal load steps.
+        pub load_steps: usize = 30,
+        /// Newton tolerance on eq. (40).
+        pub tolerance: f64 = 1e-9,
+        /// Shift of the grid to the left of the body, as a fraction of h.
+        pub grid_offset: f64 = 0.123_456_789,
+        /// Start each step from the previous increment (the solver's secant
+        /// predictor). Needed for the perfectly plastic case: at first yield
+        /// the discrete equations also admit localised solutions, and Newton
+        /// started from zero increments at the free nodes finds one.
+        pub predictor: bool = true,
     }
 }
 

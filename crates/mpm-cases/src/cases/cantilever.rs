@@ -1,0 +1,188 @@
+//! Elastic cantilever under an end load (Coombs et al. 2020 §7.3, Figs.
+//! 11–17, Table 3): a 10 m × 1 m plane-strain beam, E = 12 MPa, ν = 0.2,
+//! a vertical end load of 100 kN applied over 50 equal load steps, split
+//! between the two material points closest to the neutral axis at the free
+//! end. The neutral axis is pinned at the root and the other root nodes
+//! are on rollers (horizontal displacement fixed).
+//!
+//! Outputs: the tip displacement history (mean of the two loaded points)
+//! and the Newton residuals of every step (Table 3 shows their asymptotic
+//! quadratic convergence).
+
+use mpm_constitutive::HenckyElastic;
+use mpm_mesh::RegularGrid;
+use mpm_solver::{
+    DomainUpdater, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
+    StepReport,
+};
+use nalgebra::SVector;
+
+use crate::body::{Body, InitialDomain};
+use crate::run::{Loads, RunOutput, Setup, Snapshot, simulate};
+use crate::variant::{Variant, VariantVisitor, dispatch};
+
+crate::case_params! {
+    /// Parameters of the cantilever case (defaults: the paper's values).
+    pub struct CantileverParams {
+        /// Cell size h (m); must divide 0.5 m so that a node sits on the
+        /// neutral axis.
+        pub h: f64 = 0.5,
+        /// Material points per cell per direction (even, so that two
+        /// points straddle the neutral axis).
+        pub points_per_cell: usize = 2,
+        /// Beam length l₀ (m).
+        pub length: f64 = 10.0,
+        /// Beam depth d₀ (m).
+        pub depth: f64 = 1.0,
+        /// Young's modulus (Pa).
+        pub youngs_modulus: f64 = 12e6,
+        /// Poisson's ratio.
+        pub poisson_ratio: f64 = 0.2,
+        /// Total end load (N), downwards.
+        pub load: f64 = 100e3,
+        /// Number of equal load steps.
+        pub load_steps: usize = 50,
+        /// Newton tolerance on eq. (40).
+        pub tolerance: f64 = 1e-9,
+    }
+}
+
+/// The cantilever's result.
+#[derive(Debug, Clone)]
+pub struct CantileverResult {
+    /// The run.
+    pub output: RunOutput<2>,
+    /// (load factor, tip displacement x, tip displacement y) after each step.
+    pub tip: Vec<(f64, f64, f64)>,
+    /// Number of material points.
+    pub material_points: usize,
+}
+
+/// Grid, body, root constraints and the indices of the two loaded points.
+pub fn geometry(
+    p: &CantileverParams,
+    pad: usize,
+) -> Result<(RegularGrid<2>, Body<2>, NodalConstraints<2>, [usize; 2]), SolverError> {
+    let half = p.depth / 2.0;
+    let k = (half / p.h).round();
+    if k < 1.0
+        || (k * p.h - half).abs() > 1e-9
+        || p.points_per_cell % 2 != 0
+        || (p.length / p.h).fract().abs() > 1e-9
+    {
+        return Err(SolverError::InvalidInput(format!(
+            "h = {} must divide half the depth ({half}) and the length, and points_per_cell = {} must be even",
+            p.h, p.points_per_cell
+        )));
+    }
+    let padf = pad as f64 * p.h;
+    // Room below for a tip deflection of about the beam length.
+    let below = (p.length / p.h).ceil() * p.h;
+    let grid = RegularGrid::new(
+        SVector::<f64, 2>::new(-padf, -below - padf),
+        SVector::<f64, 2>::new(p.h, p.h),
+        [
+            ((p.length + 1.0) / p.h).ceil() as usize + 2 * pad,
+            ((below + p.depth + 0.5) / p.h).ceil() as usize + 2 * pad,
+        ],
+    )
+    .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+    let body = Body::fill_box(
+        &grid,
+        &SVector::<f64, 2>::zeros(),
+        &SVector::<f64, 2>::new(p.length, p.depth),
+        p.points_per_cell,
+    );
+    let mut constraints = NodalConstraints::<2>::new(grid.node_count());
+    let tol = 1e-9 * p.h;
+    for n in 0..grid.node_count() {
+        let x = grid
+            .node_position(n)
+            .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+        if x[0].abs() <= tol && x[1] >= -tol && x[1] <= p.depth + tol {
+            constraints.fix([n], 0);
+            if (x[1] - half).abs() <= tol {
+                constraints.fix([n], 1);
+            }
+        }
+    }
+    let [nx, ny] = body.lattice_size;
+    let loaded = |row: usize| {
+        body.lattice
+            .iter()
+            .position(|l| l[0] == nx - 1 && l[1] == row)
+    };
+    let (a, b) = (loaded(ny / 2 - 1), loaded(ny / 2));
+    match (a, b) {
+        (Some(a), Some(b)) => Ok((grid, body, constraints, [a, b])),
+        _ => Err(SolverError::InvalidInput(
+            "no material points at the loaded end".into(),
+        )),
+    }
+}
+
+struct CantileverRun<'a, O> {
+    params: &'a CantileverParams,
+    observer: O,
+}
+
+impl<O> VariantVisitor<2> for CantileverRun<'_, O>
+where
+    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
+{
+    type Output = Result<CantileverResult, SolverError>;
+
+    fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
+    where
+        B: InitialDomain<2, Mesh = RegularGrid<2>>,
+        F: Formulation,
+        U: DomainUpdater<2, B::Domain>,
+    {
+        let p = self.params;
+        let (grid, body, constraints, loaded) = geometry(p, B::PADDING)?;
+        let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio)
+            .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+        let force = SVector::<f64, 2>::new(0.0, -p.load / 2.0);
+        let setup = Setup {
+            grid,
+            body: &body,
+            density: 0.0,
+            law,
+            loads: Loads {
+                gravity: None,
+                point_forces: vec![(loaded[0], force), (loaded[1], force)],
+            },
+            constraints,
+            stepping: LoadStepping::uniform(p.load_steps),
+            newton: NewtonOptions {
+                tolerance: p.tolerance,
+                ..NewtonOptions::default()
+            },
+        };
+        let mut tip = Vec::new();
+        let mut observer = self.observer;
+        let output =
+            simulate::<2, B, F, U, _, _, _>(setup, basis, updater, |step, report, snap| {
+                let (a, b) = (&snap.displacement[loaded[0]], &snap.displacement[loaded[1]]);
+                tip.push((report.lambda1, 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])));
+                observer(step, report, snap)
+            })?;
+        Ok(CantileverResult {
+            output,
+            tip,
+            material_points: body.len(),
+        })
+    }
+}
+
+/// Runs the cantilever with `variant`.
+pub fn run<O>(
+    params: &CantileverParams,
+    variant: &Variant,
+    observer: O,
+) -> Result<CantileverResult, SolverError>
+where
+    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
+{
+    dispatch(variant, CantileverRun { params, observer }).map_err(SolverError::InvalidInput)?
+}
