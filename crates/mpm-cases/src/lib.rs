@@ -15,5 +15,6 @@ pub mod params;
 pub mod run;
 pub mod scene_file;
 pub mod variant;
+pub mod writer;
 
 pub use error::CasesError;

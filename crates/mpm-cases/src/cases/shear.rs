@@ -175,6 +175,36 @@ pub fn elastic_closed_form(mu: f64, gamma: f64) -> Matrix3<f64> {
     Matrix3::new(s11, s12, 0.0, s12, -s11, 0.0, 0.0, 0.0, 0.0)
 }
 
+/// The background grid: h-spaced, shifted left of the body by
+/// `grid_offset`·h, with room for the shear and `pad` padding cells.
+pub fn grid(p: &ShearParams, pad: usize) -> Result<RegularGrid<2>, SolverError> {
+    let cells = (1.0 / p.h).round();
+    if cells < 1.0 || (cells * p.h - 1.0).abs() > 1e-9 {
+        return Err(SolverError::InvalidInput(format!(
+            "h = {} must divide 1",
+            p.h
+        )));
+    }
+    let padf = pad as f64 * p.h;
+    let nx = ((1.0 + p.shear.abs()) / p.h).ceil() as usize + 1;
+    let offset = p.grid_offset * p.h;
+    RegularGrid::new(
+        SVector::<f64, 2>::new(
+            -padf
+                - offset
+                - if p.shear < 0.0 {
+                    p.shear.abs() + p.h
+                } else {
+                    0.0
+                },
+            -padf,
+        ),
+        SVector::<f64, 2>::new(p.h, p.h),
+        [nx + 1 + 2 * pad, cells as usize + 2 * pad],
+    )
+    .map_err(|e| SolverError::InvalidInput(e.to_string()))
+}
+
 struct ShearRun<'a, O> {
     params: &'a ShearParams,
     observer: O,
@@ -193,30 +223,7 @@ where
         L::History: HistoryOutput,
     {
         let p = self.params;
-        let cells = (1.0 / p.h).round();
-        if cells < 1.0 || (cells * p.h - 1.0).abs() > 1e-9 {
-            return Err(SolverError::InvalidInput(format!(
-                "h = {} must divide 1",
-                p.h
-            )));
-        }
-        let pad = B::PADDING as f64 * p.h;
-        let nx = ((1.0 + p.shear.abs()) / p.h).ceil() as usize + 1;
-        let offset = p.grid_offset * p.h;
-        let grid = RegularGrid::new(
-            SVector::<f64, 2>::new(
-                -pad - offset
-                    - if p.shear < 0.0 {
-                        p.shear.abs() + p.h
-                    } else {
-                        0.0
-                    },
-                -pad,
-            ),
-            SVector::<f64, 2>::new(p.h, p.h),
-            [nx + 1 + 2 * B::PADDING, cells as usize + 2 * B::PADDING],
-        )
-        .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+        let grid = grid(p, B::PADDING)?;
         if !(0.0..1.0).contains(&p.grid_offset) {
             return Err(SolverError::InvalidInput(format!(
                 "grid_offset = {} must lie in [0, 1)",

@@ -1,0 +1,338 @@
+//! `mpm`: runs the benchmark cases and scene files.
+//!
+//! ```text
+//! mpm list
+//! mpm run scene.toml [--set key=value ...] [--out DIR]
+//! mpm run --case column [--set key=value ...] [--out DIR]
+//! ```
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use anyhow::{Context, Result, anyhow, bail};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use mpm_cases::cases::{cantilever, collapse, column, shear};
+use mpm_cases::run::Snapshot;
+use mpm_cases::scene_file::parse_scene;
+use mpm_cases::variant::{BasisKind, Variant};
+use mpm_cases::writer::{RunWriter, Summary};
+use mpm_mesh::RegularGrid;
+use mpm_solver::{SolverError, StepReport};
+use serde::Serialize;
+use serde_json::{Map, Value, json};
+
+#[derive(Parser)]
+#[command(
+    name = "mpm",
+    version,
+    about = "Implicit material point method: benchmark cases and scene files"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the cases and their parameters (with defaults).
+    List,
+    /// Run a scene file or a named case.
+    Run {
+        /// Scene file (TOML); its `case` key names the case.
+        scene: Option<PathBuf>,
+        /// Case to run without a scene file.
+        #[arg(long)]
+        case: Option<String>,
+        /// Override a scene key, e.g. `--set h=1.5625 --set basis=gimp`.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+    },
+}
+
+const CASES: [(&str, &str); 4] = [
+    (
+        "column",
+        "Coombs 2020 §7.1: elastic column compacting under self weight (analytic eq. 41, error eq. 42)",
+    ),
+    (
+        "shear",
+        "Coombs 2020 §7.2: simple shear of a unit square, elastic or perfectly plastic (homogeneous)",
+    ),
+    (
+        "cantilever",
+        "Coombs 2020 §7.3: elastic cantilever under an end load (tip history, Newton residuals)",
+    ),
+    (
+        "collapse",
+        "Coombs 2020 §7.5: elasto-plastic collapse of a block (Tables 6-7)",
+    ),
+];
+
+fn main() {
+    if let Err(e) = run_cli(Cli::parse()) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run_cli(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::List => {
+            for (name, about) in CASES {
+                println!("{name}: {about}");
+                let defaults = match name {
+                    "column" => toml::to_string(&column::ColumnParams::default()),
+                    "shear" => toml::to_string(&shear::ShearParams::default()),
+                    "cantilever" => toml::to_string(&cantilever::CantileverParams::default()),
+                    _ => toml::to_string(&collapse::CollapseParams::default()),
+                }?;
+                for line in defaults.lines() {
+                    println!("    {line}");
+                }
+            }
+            println!(
+                "\nvariant values: basis = {}; formulation = ul | pc; domain_update = {}",
+                BasisKind::ALL
+                    .iter()
+                    .map(|b| b.name())
+                    .collect::<Vec<_>>()
+                    .join(" | "),
+                mpm_cases::variant::DomainUpdateKind::ALL
+                    .iter()
+                    .map(|d| d.name())
+                    .collect::<Vec<_>>()
+                    .join(" | ")
+            );
+            Ok(())
+        }
+        Command::Run {
+            scene,
+            case,
+            set,
+            out,
+        } => {
+            let (text, origin) = match &scene {
+                Some(path) => (
+                    std::fs::read_to_string(path)
+                        .with_context(|| format!("cannot read scene file {}", path.display()))?,
+                    path.display().to_string(),
+                ),
+                None => (String::new(), "command line".to_string()),
+            };
+            let scene_case = if scene.is_some() {
+                let table: toml::Table =
+                    toml::from_str(&text).map_err(|e| anyhow!("{origin}: {e}"))?;
+                table
+                    .get("case")
+                    .and_then(|v| v.as_str())
+                    .map(str::to_owned)
+            } else {
+                None
+            };
+            let name = case.or(scene_case).ok_or_else(|| {
+                anyhow!("no case: give --case NAME or a scene file with `case = \"...\"`")
+            })?;
+            match name.as_str() {
+                "column" => column_run(&parse_scene(&text, &origin, &set)?, &out),
+                "shear" => shear_run(&parse_scene(&text, &origin, &set)?, &out),
+                "cantilever" => cantilever_run(&parse_scene(&text, &origin, &set)?, &out),
+                "collapse" => collapse_run(&parse_scene(&text, &origin, &set)?, &out),
+                other => bail!(
+                    "unknown case `{other}`; cases: {}",
+                    CASES.iter().map(|c| c.0).collect::<Vec<_>>().join(", ")
+                ),
+            }
+        }
+    }
+}
+
+fn pad(basis: BasisKind) -> usize {
+    usize::from(basis == BasisKind::BSpline2)
+}
+
+/// Progress display and file output, called after every converged step.
+struct Observer {
+    writer: RunWriter,
+    bar: ProgressBar,
+    plain: bool,
+}
+
+impl Observer {
+    fn new(out: &Path, grid: RegularGrid<2>) -> Result<Self> {
+        let plain = !std::io::stderr().is_terminal();
+        let bar = if plain {
+            ProgressBar::hidden()
+        } else {
+            let bar = ProgressBar::new(1000);
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "{elapsed_precise} [{bar:30}] load {percent:>3}% {msg}",
+                )
+                .map_err(|e| anyhow!("{e}"))?
+                .progress_chars("=> "),
+            );
+            bar.enable_steady_tick(Duration::from_millis(200));
+            bar
+        };
+        Ok(Self {
+            writer: RunWriter::new(out, grid)?,
+            bar,
+            plain,
+        })
+    }
+
+    fn step(
+        &mut self,
+        step: usize,
+        report: &StepReport<2>,
+        snap: &Snapshot,
+    ) -> Result<(), SolverError> {
+        let residual = report.residuals.last().copied().unwrap_or(0.0);
+        let line = format!(
+            "step {} to load factor {:.4} (increment {:.3e}): {} iterations, residual {:.2e}",
+            step + 1,
+            report.lambda1,
+            report.lambda1 - report.lambda0,
+            report.iterations(),
+            residual
+        );
+        if self.plain {
+            eprintln!("{line}");
+        } else {
+            self.bar
+                .set_position((report.lambda1 * 1000.0).round() as u64);
+            self.bar.set_message(line);
+        }
+        self.writer
+            .step(step, report, snap)
+            .map_err(|e| SolverError::InvalidInput(format!("writing output: {e}")))
+    }
+
+    fn finish<P: Serialize>(self, summary: Summary<P>) -> Result<()> {
+        self.bar.finish_and_clear();
+        self.writer.summary(&summary)?;
+        println!(
+            "{} [{} {} {} {}]: {} points, {} steps ({} cut), {} Newton iterations, {:.3} s{}",
+            summary.case,
+            summary.variant.basis,
+            summary.variant.formulation,
+            summary.variant.locking,
+            summary.variant.domain_update,
+            summary.material_points,
+            summary.load_steps,
+            summary.cut_steps,
+            summary.newton_iterations,
+            summary.wall_time_s,
+            summary
+                .error
+                .map(|e| format!(", error {e:.4e}"))
+                .unwrap_or_default()
+        );
+        Ok(())
+    }
+}
+
+fn summary<P: Serialize>(
+    case: &str,
+    variant: Variant,
+    points: usize,
+    output: &mpm_cases::run::RunOutput<2>,
+    error: Option<f64>,
+    results: Map<String, Value>,
+    parameters: P,
+) -> Summary<P> {
+    Summary {
+        case: case.to_string(),
+        variant,
+        material_points: points,
+        load_steps: output.summary.steps,
+        cut_steps: output.summary.cut_steps,
+        newton_iterations: output.summary.iterations,
+        wall_time_s: output.wall_time_s,
+        error,
+        results,
+        parameters,
+    }
+}
+
+fn column_run(p: &column::ColumnParams, out: &Path) -> Result<()> {
+    let (grid, _, _) = column::geometry(p, pad(p.basis))?;
+    let mut obs = Observer::new(out, grid)?;
+    let r = column::run(p, &p.variant(), |s, rep, snap| obs.step(s, rep, snap))?;
+    let s = summary(
+        "column",
+        p.variant(),
+        r.material_points,
+        &r.output,
+        Some(r.error),
+        Map::new(),
+        p,
+    );
+    obs.finish(s)
+}
+
+fn shear_run(p: &shear::ShearParams, out: &Path) -> Result<()> {
+    let grid = shear::grid(p, pad(p.basis))?;
+    let mut obs = Observer::new(out, grid)?;
+    let r = shear::run(p, &p.variant(), |s, rep, snap| obs.step(s, rep, snap))?;
+    let s = summary(
+        "shear",
+        p.variant(),
+        r.material_points,
+        &r.output,
+        Some(r.error),
+        Map::new(),
+        p,
+    );
+    obs.finish(s)
+}
+
+fn cantilever_run(p: &cantilever::CantileverParams, out: &Path) -> Result<()> {
+    let (grid, ..) = cantilever::geometry(p, pad(p.basis))?;
+    let mut obs = Observer::new(out, grid)?;
+    let r = cantilever::run(p, &p.variant(), |s, rep, snap| obs.step(s, rep, snap))?;
+    let mut results = Map::new();
+    if let Some((_, ux, uy)) = r.tip.last() {
+        results.insert("tip_displacement".into(), json!([ux, uy]));
+    }
+    let mut table =
+        mpm_cases::output::CsvTable::new(&["load_factor", "tip_u_over_l0", "tip_v_over_l0"])?;
+    for (lf, ux, uy) in &r.tip {
+        table.push_row(&[(*lf).into(), (ux / p.length).into(), (uy / p.length).into()])?;
+    }
+    table.write(&out.join("tip.csv"))?;
+    let s = summary(
+        "cantilever",
+        p.variant(),
+        r.material_points,
+        &r.output,
+        None,
+        results,
+        p,
+    );
+    obs.finish(s)
+}
+
+fn collapse_run(p: &collapse::CollapseParams, out: &Path) -> Result<()> {
+    let (grid, _, _) = collapse::geometry(p, pad(p.basis))?;
+    let mut obs = Observer::new(out, grid)?;
+    let r = collapse::run(p, &p.variant(), |s, rep, snap| obs.step(s, rep, snap))?;
+    let mut results = Map::new();
+    results.insert("horizontal_extent".into(), json!(r.horizontal_extent));
+    results.insert("max_height".into(), json!(r.max_height));
+    let s = summary(
+        "collapse",
+        p.variant(),
+        r.material_points,
+        &r.output,
+        None,
+        results,
+        p,
+    );
+    obs.finish(s)
+}

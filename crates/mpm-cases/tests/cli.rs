@@ -1,0 +1,203 @@
+//! The `mpm` program: scene files, overrides, outputs and errors.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn mpm(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_mpm"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mpm-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn no_nan_in(dir: &Path) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let text = std::fs::read_to_string(entry.unwrap().path()).unwrap();
+        let lower = text.to_lowercase();
+        assert!(
+            !lower.contains("nan") && !lower.contains("inf"),
+            "non-finite value written"
+        );
+    }
+}
+
+#[test]
+fn list_names_every_case() {
+    let (ok, out, _) = mpm(&["list"]);
+    assert!(ok);
+    for case in ["column", "shear", "cantilever", "collapse"] {
+        assert!(out.contains(&format!("{case}:")), "{out}");
+    }
+}
+
+#[test]
+fn the_issue_command_line_runs_and_writes_every_output() {
+    let dir = temp_dir("column");
+    let (ok, out, err) = mpm(&[
+        "run",
+        "--case",
+        "column",
+        "--set",
+        "h=1.5625",
+        "--set",
+        "points_per_cell=2",
+        "--set",
+        "basis=gimp",
+        "--set",
+        "domain_update=stretch",
+        "--set",
+        "formulation=pc",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("column [gimp pc none stretch]"), "{out}");
+    for file in [
+        "points.pvd",
+        "grid.pvd",
+        "points_0019.vtu",
+        "grid_0019.vtu",
+        "steps.csv",
+        "iterations.csv",
+        "summary.json",
+    ] {
+        assert!(dir.join(file).exists(), "{file} missing");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["case"], "column");
+    assert_eq!(summary["variant"]["basis"], "gimp");
+    assert_eq!(summary["material_points"], 128);
+    assert_eq!(summary["load_steps"], 20);
+    assert!(summary["newton_iterations"].as_u64().unwrap() >= 20);
+    assert!(summary["wall_time_s"].as_f64().unwrap() > 0.0);
+    assert!(summary["error"].as_f64().unwrap() < 5e-3);
+    no_nan_in(&dir);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn scene_files_run_and_bad_scenes_report_line_and_column() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/collapse.toml");
+    let dir = temp_dir("collapse");
+    let (ok, out, err) = mpm(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--set",
+        "points_per_cell=2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert!(
+        summary["horizontal_extent"].as_f64().unwrap() > 13.0,
+        "{out}"
+    );
+    assert!(summary["max_height"].as_f64().unwrap() < 7.0);
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    let bad = temp_dir("bad");
+    std::fs::create_dir_all(&bad).unwrap();
+    let path = bad.join("bad.toml");
+    std::fs::write(&path, "case = \"column\"\nh = 1.5625\nbsis = \"gimp\"\n").unwrap();
+    let (ok, _, err) = mpm(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        bad.join("o").to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("bad.toml:3:1") && err.contains("unknown field `bsis`"),
+        "{err}"
+    );
+    std::fs::write(&path, "case = \"column\"\nh = \"fine\"\n").unwrap();
+    let (ok, _, err) = mpm(&["run", path.to_str().unwrap()]);
+    assert!(!ok && err.contains("bad.toml:2:5"), "{err}");
+    std::fs::remove_dir_all(&bad).unwrap();
+}
+
+#[test]
+fn bad_input_fails_cleanly() {
+    for (args, expected) in [
+        (
+            vec!["run", "--case", "column", "--set", "basis=quartic"],
+            "unknown variant",
+        ),
+        (vec!["run", "--case", "nope"], "unknown case"),
+        (
+            vec!["run", "--case", "collapse", "--set", "h=3"],
+            "must divide",
+        ),
+        (
+            vec!["run", "--case", "column", "--set", "h=-1"],
+            "must divide",
+        ),
+        (
+            vec!["run", "--case", "column", "--set", "youngs_modulus=-5"],
+            "Young's modulus",
+        ),
+        (vec!["run"], "no case"),
+    ] {
+        let (ok, _, err) = mpm(&args);
+        assert!(!ok, "{args:?} should fail");
+        assert!(err.contains(expected), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+/// A tolerance below round-off cannot be met: the step is halved down to
+/// the minimum and the run stops with a typed error naming the step, the
+/// last residual and the cause. Points pulled out of the grid stop the
+/// run with an error naming the point.
+#[test]
+fn non_convergence_and_points_leaving_the_grid_are_diagnosed() {
+    let dir = temp_dir("diverge");
+    let (ok, _, err) = mpm(&[
+        "run",
+        "--case",
+        "column",
+        "--set",
+        "tolerance=1e-30",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("load step 0")
+            && err.contains("last normalised residual")
+            && err.contains("no convergence in 30 iterations"),
+        "{err}"
+    );
+    let (ok, _, err) = mpm(&[
+        "run",
+        "--case",
+        "column",
+        "--set",
+        "gravity=-2e4",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("material point") && err.contains("lies outside the grid"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    no_nan_in(&dir);
+    let _ = std::fs::remove_dir_all(&dir);
+}
