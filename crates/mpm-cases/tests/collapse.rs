@@ -46,11 +46,7 @@ fn standard_mpm_collapse_reproduces_table_6_within_one_percent() {
         for report in &r.output.reports {
             let res = &report.residuals;
             assert!(res[res.len() - 1] <= 1e-9);
-            if let Some(w) = res
-                .windows(2)
-                .filter(|w| w[0] < 1e-2 && w[1] > 1e-12)
-                .last()
-            {
+            if let Some(w) = res.windows(2).rfind(|w| w[0] < 1e-2 && w[1] > 1e-12) {
                 assert!(w[1] <= 100.0 * w[0] * w[0], "{res:?}");
             }
         }

@@ -2,7 +2,7 @@
 #![allow(clippy::unwrap_used)]
 
 use mpm_cases::cases::column::{ColumnParams, run};
-use mpm_cases::variant::{BasisKind, DomainUpdateKind, FormulationKind, Variant};
+use mpm_cases::variant::{BasisKind, DomainUpdateKind, FormulationKind};
 
 fn params(
     k: i32,

@@ -89,14 +89,14 @@ impl LinearSolver {
         }
         let k = SparseColMatRef::new(self.pattern.as_ref(), values);
         let mut b = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
-        if self.symmetric && self.last != Some(Factorisation::Lu) {
-            if let Some(symbolic) = &self.llt {
-                if let Ok(llt) = Llt::try_new_with_symbolic(symbolic.clone(), k, Side::Lower) {
-                    llt.solve_in_place(b.as_mut());
-                    self.last = Some(Factorisation::Cholesky);
-                    return finite(rhs, Factorisation::Cholesky);
-                }
-            }
+        if self.symmetric
+            && self.last != Some(Factorisation::Lu)
+            && let Some(symbolic) = &self.llt
+            && let Ok(llt) = Llt::try_new_with_symbolic(symbolic.clone(), k, Side::Lower)
+        {
+            llt.solve_in_place(b.as_mut());
+            self.last = Some(Factorisation::Cholesky);
+            return finite(rhs, Factorisation::Cholesky);
         }
         if self.lu.is_none() {
             self.lu =

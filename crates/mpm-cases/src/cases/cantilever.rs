@@ -67,7 +67,7 @@ pub fn geometry(
     let k = (half / p.h).round();
     if k < 1.0
         || (k * p.h - half).abs() > 1e-9
-        || p.points_per_cell % 2 != 0
+        || !p.points_per_cell.is_multiple_of(2)
         || (p.length / p.h).fract().abs() > 1e-9
     {
         return Err(SolverError::InvalidInput(format!(
