@@ -75,11 +75,19 @@ impl SymSpectral {
         let (a, b, c) = (sym[(0, 0)], sym[(0, 1)], sym[(1, 1)]);
         let m = 0.5 * (a + c);
         let r = (0.5 * (a - c)).hypot(b);
-        let (big, small) = if m >= 0.0 { (m + r, m - r) } else { (m - r, m + r) };
+        let (big, small) = if m >= 0.0 {
+            (m + r, m - r)
+        } else {
+            (m - r, m + r)
+        };
         let det = a * c - b * b;
         // The eigenvalue of smaller magnitude from det/big avoids the
         // cancellation in m ∓ r.
-        let small = if big != 0.0 && small.abs() < 0.5 * big.abs() { det / big } else { small };
+        let small = if big != 0.0 && small.abs() < 0.5 * big.abs() {
+            det / big
+        } else {
+            small
+        };
         let (l1, l2) = if m >= 0.0 { (big, small) } else { (small, big) };
         let theta = 0.5 * (2.0 * b).atan2(a - c);
         let (sn, cs) = theta.sin_cos();
@@ -217,7 +225,8 @@ mod tests {
             let v = s.vectors;
             assert!((v.transpose() * v - Matrix3::identity()).norm() < 1e-15);
             assert!((s.compose(&s.values) - m).norm() <= 4e-16 * m.norm(), "{k}");
-            let mut reference: Vec<f64> = SymmetricEigen::new(m).eigenvalues.iter().copied().collect();
+            let mut reference: Vec<f64> =
+                SymmetricEigen::new(m).eigenvalues.iter().copied().collect();
             let mut ours: Vec<f64> = s.values.iter().copied().collect();
             reference.sort_by(f64::total_cmp);
             ours.sort_by(f64::total_cmp);
