@@ -953,10 +953,7 @@ where
         points: &MaterialPoints<D, L::History, B::Domain>,
         du_free: &[f64],
     ) -> Result<Vec<f64>, StepFailure> {
-        self.set_free_increment(du_free);
-        self.update_material_points(points)?;
-        self.update_tangents(points)?;
-        self.assemble_stiffness();
+        self.assemble_at(points, du_free)?;
         let sys = &self.system;
         let n = sys.n_free;
         let mut k = vec![0.0; n * n];

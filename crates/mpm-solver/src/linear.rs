@@ -39,6 +39,8 @@ pub struct LinearSolver {
     lu: Option<SymbolicLu<usize>>,
     symmetric: bool,
     last: Option<Factorisation>,
+    b: Vec<f64>,
+    r: Vec<f64>,
 }
 
 impl LinearSolver {
@@ -67,6 +69,8 @@ impl LinearSolver {
             lu: None,
             symmetric,
             last: None,
+            b: Vec::new(),
+            r: Vec::new(),
         })
     }
 
@@ -87,27 +91,87 @@ impl LinearSolver {
         if n == 0 {
             return Ok(Factorisation::Cholesky);
         }
+        self.b.clear();
+        self.b.extend_from_slice(rhs);
+        let factor = self.factorise(values)?;
+        let apply = |x: &mut [f64]| {
+            let m = faer::MatMut::from_column_major_slice_mut(x, n, 1);
+            match &factor {
+                Factor::Cholesky(llt) => llt.solve_in_place(m),
+                Factor::Lu(lu) => lu.solve_in_place(m),
+            }
+        };
+        apply(rhs);
+        // Iterative refinement: x += K⁻¹(b − Kx) while the residual keeps
+        // shrinking. Nearly singular stiffnesses (weakly supported nodes)
+        // otherwise leave solve errors that stall Newton above the
+        // tolerance, notably with the LU fallback.
+        let b_norm = norm(&self.b);
+        let mut previous = f64::INFINITY;
+        for _ in 0..MAX_REFINEMENTS {
+            self.r.clear();
+            self.r.extend_from_slice(&self.b);
+            let (col_ptr, row_idx) = (self.pattern.col_ptr(), self.pattern.row_idx());
+            for (c, x) in rhs.iter().enumerate() {
+                for e in col_ptr[c]..col_ptr[c + 1] {
+                    self.r[row_idx[e]] -= values[e] * x;
+                }
+            }
+            let r_norm = norm(&self.r);
+            if !(r_norm.is_finite() && r_norm > 1e-15 * b_norm && r_norm < 0.5 * previous) {
+                break;
+            }
+            previous = r_norm;
+            apply(&mut self.r);
+            rhs.iter_mut().zip(&self.r).for_each(|(x, d)| *x += d);
+        }
+        finite(rhs, factor.kind())
+    }
+
+    /// Cholesky when the values are symmetric and the last attempt did not
+    /// meet a non-positive pivot, LU otherwise (its symbolic analysis made
+    /// once per pattern).
+    fn factorise(&mut self, values: &[f64]) -> Result<Factor, String> {
         let k = SparseColMatRef::new(self.pattern.as_ref(), values);
-        let mut b = faer::MatMut::from_column_major_slice_mut(rhs, n, 1);
         if self.symmetric
             && self.last != Some(Factorisation::Lu)
             && let Some(symbolic) = &self.llt
             && let Ok(llt) = Llt::try_new_with_symbolic(symbolic.clone(), k, Side::Lower)
         {
-            llt.solve_in_place(b.as_mut());
             self.last = Some(Factorisation::Cholesky);
-            return finite(rhs, Factorisation::Cholesky);
+            return Ok(Factor::Cholesky(llt));
         }
         if self.lu.is_none() {
             self.lu =
                 Some(SymbolicLu::try_new(self.pattern.as_ref()).map_err(|e| format!("{e:?}"))?);
         }
         let symbolic = self.lu.clone().ok_or("symbolic LU missing")?;
+        let k = SparseColMatRef::new(self.pattern.as_ref(), values);
         let lu = Lu::try_new_with_symbolic(symbolic, k).map_err(|e| format!("sparse LU: {e:?}"))?;
-        lu.solve_in_place(b.as_mut());
         self.last = Some(Factorisation::Lu);
-        finite(rhs, Factorisation::Lu)
+        Ok(Factor::Lu(lu))
     }
+}
+
+/// Steps of iterative refinement after a direct solve.
+const MAX_REFINEMENTS: usize = 3;
+
+enum Factor {
+    Cholesky(Llt<usize, f64>),
+    Lu(Lu<usize, f64>),
+}
+
+impl Factor {
+    fn kind(&self) -> Factorisation {
+        match self {
+            Factor::Cholesky(_) => Factorisation::Cholesky,
+            Factor::Lu(_) => Factorisation::Lu,
+        }
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 fn finite(x: &[f64], f: Factorisation) -> Result<Factorisation, String> {
