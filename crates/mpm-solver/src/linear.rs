@@ -149,7 +149,7 @@ impl LinearSolver {
         let k = SparseColMatRef::new(self.pattern.as_ref(), values);
         let lu = Lu::try_new_with_symbolic(symbolic, k).map_err(|e| format!("sparse LU: {e:?}"))?;
         self.last = Some(Factorisation::Lu);
-        Ok(Factor::Lu(lu))
+        Ok(Factor::Lu(Box::new(lu)))
     }
 }
 
@@ -158,7 +158,7 @@ const MAX_REFINEMENTS: usize = 3;
 
 enum Factor {
     Cholesky(Llt<usize, f64>),
-    Lu(Lu<usize, f64>),
+    Lu(Box<Lu<usize, f64>>),
 }
 
 impl Factor {
