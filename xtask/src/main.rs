@@ -12,6 +12,7 @@ use std::path::Path;
 
 use anyhow::{Result, bail};
 use mpm_cases::cases::column::{ColumnParams, run};
+use mpm_cases::run::RunControl;
 use mpm_cases::variant::{BasisKind, DomainUpdateKind};
 
 fn main() -> Result<()> {
@@ -62,7 +63,7 @@ fn column_table() -> Result<()> {
             let mut best = f64::INFINITY;
             let mut last = None;
             for _ in 0..3 {
-                let r = run(&p, &p.variant(), |_, _, _| Ok(()))?;
+                let r = run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))?;
                 best = best.min(r.output.wall_time_s);
                 last = Some(r);
             }

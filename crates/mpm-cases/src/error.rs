@@ -20,6 +20,14 @@ pub enum CasesError {
         /// The operating system's error.
         source: std::io::Error,
     },
+    /// A checkpoint file that cannot be resumed from.
+    #[error("{}: not a usable checkpoint: {reason}", path.display())]
+    Checkpoint {
+        /// The checkpoint file.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// A path that cannot be written to or referred to.
     #[error("{}: {reason}", path.display())]
     InvalidPath {

@@ -9,6 +9,7 @@
 
 pub mod body;
 pub mod cases;
+pub mod checkpoint;
 pub mod error;
 pub mod output;
 pub mod params;

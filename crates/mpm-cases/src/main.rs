@@ -7,14 +7,15 @@
 //! ```
 
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use mpm_cases::cases::{cantilever, collapse, column, shear};
-use mpm_cases::run::Snapshot;
+use mpm_cases::checkpoint;
+use mpm_cases::run::{RunControl, Snapshot};
 use mpm_cases::scene_file::parse_scene;
 use mpm_cases::variant::{BasisKind, Variant};
 use mpm_cases::writer::{RunWriter, Summary};
@@ -51,6 +52,16 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
+        /// Continue an interrupted run from the checkpoint in the output
+        /// directory (written after every converged step); the scene and
+        /// overrides must be the same as those of the interrupted run.
+        #[arg(long)]
+        resume: bool,
+        /// Stop (with a checkpoint) after this many converged steps of this
+        /// session, e.g. to split a long run into jobs; continue with
+        /// `--resume`.
+        #[arg(long, value_name = "N")]
+        stop_after: Option<usize>,
     },
 }
 
@@ -115,6 +126,8 @@ fn run_cli(cli: Cli) -> Result<()> {
             case,
             set,
             out,
+            resume,
+            stop_after,
         } => {
             let (text, origin) = match &scene {
                 Some(path) => (
@@ -137,15 +150,33 @@ fn run_cli(cli: Cli) -> Result<()> {
             let name = case.or(scene_case).ok_or_else(|| {
                 anyhow!("no case: give --case NAME or a scene file with `case = \"...\"`")
             })?;
-            match name.as_str() {
-                "column" => column_run(&parse_scene(&text, &origin, &set)?, &out),
-                "shear" => shear_run(&parse_scene(&text, &origin, &set)?, &out),
-                "cantilever" => cantilever_run(&parse_scene(&text, &origin, &set)?, &out),
-                "collapse" => collapse_run(&parse_scene(&text, &origin, &set)?, &out),
+            let run = Run {
+                case: name.clone(),
+                out,
+                resume,
+                stop_after,
+            };
+            let result = match name.as_str() {
+                "column" => column_run(&parse_scene(&text, &origin, &set)?, &run),
+                "shear" => shear_run(&parse_scene(&text, &origin, &set)?, &run),
+                "cantilever" => cantilever_run(&parse_scene(&text, &origin, &set)?, &run),
+                "collapse" => collapse_run(&parse_scene(&text, &origin, &set)?, &run),
                 other => bail!(
                     "unknown case `{other}`; cases: {}",
                     CASES.iter().map(|c| c.0).collect::<Vec<_>>().join(", ")
                 ),
+            };
+            match result {
+                Err(e) => match e.downcast_ref::<SolverError>() {
+                    Some(SolverError::Stopped { step, load_factor }) => {
+                        println!(
+                            "stopped after load step {step} at load factor {load_factor}; continue with --resume"
+                        );
+                        Ok(())
+                    }
+                    _ => Err(e),
+                },
+                ok => ok,
             }
         }
     }
@@ -155,15 +186,60 @@ fn pad(basis: BasisKind) -> usize {
     usize::from(basis == BasisKind::BSpline2)
 }
 
+/// Where a run writes and whether it resumes.
+struct Run {
+    case: String,
+    out: PathBuf,
+    resume: bool,
+    stop_after: Option<usize>,
+}
+
+impl Run {
+    /// The observer and the run control for a case with parameters `p`:
+    /// checkpoints always; with `--resume`, the checkpoint of the output
+    /// directory, which must have been written by the same case and
+    /// parameters.
+    fn start<P: Serialize>(&self, p: &P, grid: RegularGrid<2>) -> Result<(Observer, RunControl)> {
+        let parameters = serde_json::to_value(p)?;
+        let (writer, resume) = if self.resume {
+            let (header, checkpoint) = checkpoint::read(&self.out)?;
+            if header.case != self.case || header.parameters != parameters {
+                bail!(
+                    "--resume: {} was written by case `{}` with other parameters; run again without --resume, or with the scene and --set keys of that run",
+                    self.out.join(checkpoint::FILE_NAME).display(),
+                    header.case
+                );
+            }
+            (
+                RunWriter::resume(&self.out, grid, header.writer)?,
+                Some(checkpoint),
+            )
+        } else {
+            (RunWriter::new(&self.out, grid)?, None)
+        };
+        let control = RunControl {
+            checkpoint: true,
+            resume,
+        };
+        let mut observer = Observer::new(writer, self.case.clone(), parameters)?;
+        observer.stop_after = self.stop_after;
+        Ok((observer, control))
+    }
+}
+
 /// Progress display and file output, called after every converged step.
 struct Observer {
     writer: RunWriter,
     bar: ProgressBar,
     plain: bool,
+    case: String,
+    parameters: Value,
+    stop_after: Option<usize>,
+    steps: usize,
 }
 
 impl Observer {
-    fn new(out: &Path, grid: RegularGrid<2>) -> Result<Self> {
+    fn new(writer: RunWriter, case: String, parameters: Value) -> Result<Self> {
         let plain = !std::io::stderr().is_terminal();
         let bar = if plain {
             ProgressBar::hidden()
@@ -180,9 +256,13 @@ impl Observer {
             bar
         };
         Ok(Self {
-            writer: RunWriter::new(out, grid)?,
+            writer,
             bar,
             plain,
+            case,
+            parameters,
+            stop_after: None,
+            steps: 0,
         })
     }
 
@@ -208,9 +288,28 @@ impl Observer {
                 .set_position((report.lambda1 * 1000.0).round() as u64);
             self.bar.set_message(line);
         }
-        self.writer
-            .step(step, report, snap)
-            .map_err(|e| SolverError::InvalidInput(format!("writing output: {e}")))
+        let io =
+            |e: mpm_cases::CasesError| SolverError::InvalidInput(format!("writing output: {e}"));
+        self.writer.step(step, report, snap).map_err(io)?;
+        if let Some(c) = &snap.checkpoint {
+            checkpoint::write(
+                self.writer.dir(),
+                &self.case,
+                self.parameters.clone(),
+                c,
+                self.writer.state(),
+            )
+            .map_err(io)?;
+        }
+        self.steps += 1;
+        if self.stop_after.is_some_and(|n| self.steps >= n) && report.lambda1 < 1.0 {
+            self.bar.finish_and_clear();
+            return Err(SolverError::Stopped {
+                step: step + 1,
+                load_factor: report.lambda1,
+            });
+        }
+        Ok(())
     }
 
     fn finish<P: Serialize>(self, summary: Summary<P>) -> Result<()> {
@@ -260,10 +359,12 @@ fn summary<P: Serialize>(
     }
 }
 
-fn column_run(p: &column::ColumnParams, out: &Path) -> Result<()> {
+fn column_run(p: &column::ColumnParams, run: &Run) -> Result<()> {
     let (grid, _, _) = column::geometry(p, pad(p.basis))?;
-    let mut obs = Observer::new(out, grid)?;
-    let r = column::run(p, &p.variant(), |s, rep, snap| obs.step(s, rep, snap))?;
+    let (mut obs, control) = run.start(p, grid)?;
+    let r = column::run(p, &p.variant(), &control, |s, rep, snap| {
+        obs.step(s, rep, snap)
+    })?;
     let s = summary(
         "column",
         p.variant(),
@@ -276,10 +377,12 @@ fn column_run(p: &column::ColumnParams, out: &Path) -> Result<()> {
     obs.finish(s)
 }
 
-fn shear_run(p: &shear::ShearParams, out: &Path) -> Result<()> {
+fn shear_run(p: &shear::ShearParams, run: &Run) -> Result<()> {
     let grid = shear::grid(p, pad(p.basis))?;
-    let mut obs = Observer::new(out, grid)?;
-    let r = shear::run(p, &p.variant(), |s, rep, snap| obs.step(s, rep, snap))?;
+    let (mut obs, control) = run.start(p, grid)?;
+    let r = shear::run(p, &p.variant(), &control, |s, rep, snap| {
+        obs.step(s, rep, snap)
+    })?;
     let s = summary(
         "shear",
         p.variant(),
@@ -292,20 +395,29 @@ fn shear_run(p: &shear::ShearParams, out: &Path) -> Result<()> {
     obs.finish(s)
 }
 
-fn cantilever_run(p: &cantilever::CantileverParams, out: &Path) -> Result<()> {
-    let (grid, ..) = cantilever::geometry(p, pad(p.basis))?;
-    let mut obs = Observer::new(out, grid)?;
-    let r = cantilever::run(p, &p.variant(), |s, rep, snap| obs.step(s, rep, snap))?;
+fn cantilever_run(p: &cantilever::CantileverParams, run: &Run) -> Result<()> {
+    let (grid, _, _, loaded) = cantilever::geometry(p, pad(p.basis))?;
+    let (mut obs, control) = run.start(p, grid)?;
+    let r = cantilever::run(p, &p.variant(), &control, |s, rep, snap| {
+        // The case table first: the step's checkpoint must hold its row.
+        let (ux, uy) = cantilever::tip_displacement(snap, loaded);
+        obs.writer
+            .case_row(
+                "tip.csv",
+                &["load_factor", "tip_u_over_l0", "tip_v_over_l0"],
+                &[
+                    rep.lambda1.into(),
+                    (ux / p.length).into(),
+                    (uy / p.length).into(),
+                ],
+            )
+            .map_err(|e| SolverError::InvalidInput(format!("writing output: {e}")))?;
+        obs.step(s, rep, snap)
+    })?;
     let mut results = Map::new();
     if let Some((_, ux, uy)) = r.tip.last() {
         results.insert("tip_displacement".into(), json!([ux, uy]));
     }
-    let mut table =
-        mpm_cases::output::CsvTable::new(&["load_factor", "tip_u_over_l0", "tip_v_over_l0"])?;
-    for (lf, ux, uy) in &r.tip {
-        table.push_row(&[(*lf).into(), (ux / p.length).into(), (uy / p.length).into()])?;
-    }
-    table.write(&out.join("tip.csv"))?;
     let s = summary(
         "cantilever",
         p.variant(),
@@ -318,10 +430,12 @@ fn cantilever_run(p: &cantilever::CantileverParams, out: &Path) -> Result<()> {
     obs.finish(s)
 }
 
-fn collapse_run(p: &collapse::CollapseParams, out: &Path) -> Result<()> {
+fn collapse_run(p: &collapse::CollapseParams, run: &Run) -> Result<()> {
     let (grid, _, _) = collapse::geometry(p, pad(p.basis))?;
-    let mut obs = Observer::new(out, grid)?;
-    let r = collapse::run(p, &p.variant(), |s, rep, snap| obs.step(s, rep, snap))?;
+    let (mut obs, control) = run.start(p, grid)?;
+    let r = collapse::run(p, &p.variant(), &control, |s, rep, snap| {
+        obs.step(s, rep, snap)
+    })?;
     let mut results = Map::new();
     results.insert("horizontal_extent".into(), json!(r.horizontal_extent));
     results.insert("max_height".into(), json!(r.max_height));

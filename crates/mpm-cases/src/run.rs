@@ -5,8 +5,8 @@ use std::time::Instant;
 use mpm_constitutive::{LogStrainLaw, VonMisesHistory};
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    Constraints, DomainUpdater, Formulation, ImplicitSolver, LoadStepping, MaterialPoints,
-    NewtonOptions, NoLocking, RunSummary, SolverError, StepReport,
+    Constraints, DomainUpdater, Flat, Formulation, ImplicitSolver, LoadStepping, MaterialPoints,
+    NewtonOptions, NoLocking, RunState, RunSummary, SolverError, StepReport,
 };
 use nalgebra::SVector;
 
@@ -48,6 +48,37 @@ pub struct Snapshot {
     pub volume: Vec<f64>,
     /// Equivalent plastic strain.
     pub plastic_strain: Vec<f64>,
+    /// Everything needed to resume after this step, when the run was asked
+    /// for checkpoints ([`RunControl::checkpoint`]).
+    pub checkpoint: Option<Checkpoint>,
+}
+
+/// The state of a run between two steps, from which it can be resumed with
+/// the same results as an uninterrupted run (see [`crate::checkpoint`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Checkpoint {
+    /// Load stepping state.
+    pub state: RunState,
+    /// The Newton predictor's memory (increment per mesh dof, load
+    /// increment).
+    pub predictor: Option<(Vec<f64>, f64)>,
+    /// The material points ([`MaterialPoints::to_flat`]).
+    pub points: Vec<f64>,
+    /// Solver wall time so far (s).
+    pub wall_time_s: f64,
+    /// The case's own accumulators (e.g. a reference solution driven along
+    /// the run and the largest error so far), written by the case and
+    /// restored by it on resume.
+    pub case_state: Vec<f64>,
+}
+
+/// How a run is driven beyond its scene: checkpoints and resumption.
+#[derive(Debug, Clone, Default)]
+pub struct RunControl {
+    /// Attach a [`Checkpoint`] to every step's [`Snapshot`].
+    pub checkpoint: bool,
+    /// Continue from this checkpoint instead of starting at load factor 0.
+    pub resume: Option<Checkpoint>,
 }
 
 impl Snapshot {
@@ -84,6 +115,7 @@ impl Snapshot {
                 .iter()
                 .map(HistoryOutput::equivalent_plastic_strain)
                 .collect(),
+            checkpoint: None,
         }
     }
 }
@@ -102,11 +134,12 @@ pub struct Loads<const D: usize> {
 pub struct RunOutput<const D: usize> {
     /// The final state.
     pub last: Snapshot,
-    /// Reports of the converged steps.
+    /// Reports of the converged steps (of this session, when resumed).
     pub reports: Vec<StepReport<D>>,
     /// Step and iteration counts.
     pub summary: RunSummary,
-    /// Solver wall time (observer time excluded), seconds.
+    /// Solver wall time (observer time excluded), seconds, including the
+    /// time before a resumed checkpoint.
     pub wall_time_s: f64,
 }
 
@@ -133,19 +166,21 @@ pub struct Setup<'a, const D: usize, L, C> {
 
 /// Runs `setup` with basis `B`, formulation `F` and updater `U`; `observer`
 /// sees each converged step's report and state (its time is excluded from
-/// `wall_time_s`).
+/// `wall_time_s`). `control` asks for checkpoints or resumes from one.
 pub fn simulate<const D: usize, B, F, U, L, C, O>(
     setup: Setup<'_, D, L, C>,
     basis: B,
     updater: U,
+    control: &RunControl,
     mut observer: O,
 ) -> Result<RunOutput<D>, SolverError>
 where
     B: InitialDomain<D, Mesh = RegularGrid<D>>,
+    B::Domain: Flat,
     F: Formulation,
     U: DomainUpdater<D, B::Domain>,
     L: LogStrainLaw,
-    L::History: HistoryOutput,
+    L::History: HistoryOutput + Flat,
     C: Constraints<D>,
     O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
@@ -175,18 +210,48 @@ where
         setup.constraints,
         setup.newton,
     );
+    let (state, earlier_time) = match &control.resume {
+        Some(c) => {
+            let resumed = MaterialPoints::from_flat(&c.points)?;
+            if resumed.len() != points.len() {
+                return Err(SolverError::InvalidInput(format!(
+                    "the checkpoint holds {} material points, the scene {}",
+                    resumed.len(),
+                    points.len()
+                )));
+            }
+            points = resumed;
+            solver.set_predictor_state(c.predictor.clone())?;
+            (c.state, c.wall_time_s)
+        }
+        None => (RunState::start(&setup.stepping), 0.0),
+    };
     let mut reports = Vec::new();
     let mut observer_time = 0.0;
     let start = Instant::now();
-    let summary = solver.run(&mut points, &setup.stepping, |step, report, pts| {
-        let t = Instant::now();
-        reports.push(report.clone());
-        let snapshot = Snapshot::of(pts, report.lambda1);
-        observer(step, report, &snapshot)?;
-        observer_time += t.elapsed().as_secs_f64();
-        Ok(())
-    })?;
-    let wall_time_s = start.elapsed().as_secs_f64() - observer_time;
+    let summary = solver.run_from(
+        &mut points,
+        &setup.stepping,
+        state,
+        |step, report, pts, now| {
+            let t = Instant::now();
+            reports.push(report.clone());
+            let mut snapshot = Snapshot::of(pts, report.lambda1);
+            if control.checkpoint {
+                snapshot.checkpoint = Some(Checkpoint {
+                    state: now.state,
+                    predictor: now.predictor.map(|(u, dl)| (u.to_vec(), dl)),
+                    points: pts.to_flat(),
+                    wall_time_s: earlier_time + start.elapsed().as_secs_f64() - observer_time,
+                    case_state: Vec::new(),
+                });
+            }
+            observer(step, report, &snapshot)?;
+            observer_time += t.elapsed().as_secs_f64();
+            Ok(())
+        },
+    )?;
+    let wall_time_s = earlier_time + start.elapsed().as_secs_f64() - observer_time;
     Ok(RunOutput {
         last: Snapshot::of(&points, 1.0),
         reports,

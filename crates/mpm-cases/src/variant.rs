@@ -8,7 +8,7 @@ use std::str::FromStr;
 use mpm_basis::{Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    DomainUpdater, Formulation, NoUpdate, PreviouslyConverged, StretchU, UpdatedLagrangian,
+    DomainUpdater, Flat, Formulation, NoUpdate, PreviouslyConverged, StretchU, UpdatedLagrangian,
 };
 use serde::{Deserialize, Serialize};
 
@@ -139,7 +139,7 @@ pub trait VariantVisitor<const D: usize> {
     /// Runs with basis `B`, formulation `F` and domain updater `U`.
     fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
     where
-        B: InitialDomain<D, Mesh = RegularGrid<D>>,
+        B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat>,
         F: Formulation,
         U: DomainUpdater<D, B::Domain>;
 }
@@ -158,7 +158,7 @@ pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
     ) -> V::Output
     where
         V: VariantVisitor<D>,
-        B: InitialDomain<D, Mesh = RegularGrid<D>>,
+        B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat>,
         U: DomainUpdater<D, B::Domain>,
     {
         match f {

@@ -3,6 +3,7 @@
 //! `summary.json`. Every file is written atomically, so an interrupted run
 //! leaves valid files behind.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use mpm_mesh::RegularGrid;
@@ -11,7 +12,7 @@ use serde::Serialize;
 
 use crate::CasesError;
 use crate::output::{
-    CellType, CsvTable, CsvValue, PvdSeries, UnstructuredGrid, Values, write_summary,
+    CellType, CsvTable, CsvValue, PvdSeries, PvdStep, UnstructuredGrid, Values, write_summary,
 };
 use crate::run::Snapshot;
 use crate::variant::Variant;
@@ -25,6 +26,23 @@ pub struct RunWriter {
     cells: PvdSeries,
     steps: CsvTable,
     iterations: CsvTable,
+    tables: BTreeMap<String, CsvTable>,
+}
+
+/// What a [`RunWriter`] has written so far, saved with a checkpoint so
+/// that a resumed run extends the same series and tables.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct WriterState {
+    /// Entries of `points.pvd`.
+    pub points: Vec<PvdStep>,
+    /// Entries of `grid.pvd`.
+    pub grid: Vec<PvdStep>,
+    /// `steps.csv`.
+    pub steps: CsvTable,
+    /// `iterations.csv`.
+    pub iterations: CsvTable,
+    /// Case tables by file name ([`RunWriter::case_row`]).
+    pub tables: BTreeMap<String, CsvTable>,
 }
 
 /// What `summary.json` holds.
@@ -76,7 +94,65 @@ impl RunWriter {
                 "free_dofs",
             ])?,
             iterations: CsvTable::new(&["step", "iteration", "normalised_residual"])?,
+            tables: BTreeMap::new(),
         })
+    }
+
+    /// A writer that continues the series and tables of `state` (a resumed
+    /// run); files of later steps are overwritten as the run proceeds.
+    pub fn resume(
+        dir: &Path,
+        grid: RegularGrid<2>,
+        state: WriterState,
+    ) -> Result<Self, CasesError> {
+        if state.steps.header() != Self::new(dir, grid.clone())?.steps.header() {
+            return Err(CasesError::Checkpoint {
+                path: dir.to_path_buf(),
+                reason: "its steps table has other columns than this version writes".into(),
+            });
+        }
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            grid,
+            points: PvdSeries::with_steps(dir.join("points.pvd"), state.points),
+            cells: PvdSeries::with_steps(dir.join("grid.pvd"), state.grid),
+            steps: state.steps,
+            iterations: state.iterations,
+            tables: state.tables,
+        })
+    }
+
+    /// What has been written so far.
+    pub fn state(&self) -> WriterState {
+        WriterState {
+            points: self.points.steps().to_vec(),
+            grid: self.cells.steps().to_vec(),
+            steps: self.steps.clone(),
+            iterations: self.iterations.clone(),
+            tables: self.tables.clone(),
+        }
+    }
+
+    /// Appends a row to the case table `file` (e.g. the cantilever's
+    /// `tip.csv`), creating it with `header` on first use, and rewrites the
+    /// file atomically; the table is part of [`WriterState`].
+    pub fn case_row(
+        &mut self,
+        file: &str,
+        header: &[&str],
+        row: &[CsvValue<'_>],
+    ) -> Result<(), CasesError> {
+        let table = match self.tables.entry(file.to_string()) {
+            std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::btree_map::Entry::Vacant(e) => e.insert(CsvTable::new(header)?),
+        };
+        table.push_row(row)?;
+        table.write(&self.dir.join(file))
+    }
+
+    /// The output directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
     }
 
     /// Writes the files of one converged step.

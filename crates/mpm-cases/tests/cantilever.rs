@@ -3,18 +3,26 @@
 #![allow(clippy::unwrap_used)]
 
 use mpm_cases::cases::cantilever::{CantileverParams, run};
+use mpm_cases::run::RunControl;
 use mpm_cases::variant::{FormulationKind, Variant};
 
 #[test]
 fn cantilever_converges_quadratically_and_ul_equals_pc() {
     let p = CantileverParams::default();
-    let pc = run(&p, &Variant::default(), |_, _, _| Ok(())).unwrap();
+    let pc = run(
+        &p,
+        &Variant::default(),
+        &RunControl::default(),
+        |_, _, _| Ok(()),
+    )
+    .unwrap();
     let ul = run(
         &p,
         &Variant {
             formulation: FormulationKind::Ul,
             ..Variant::default()
         },
+        &RunControl::default(),
         |_, _, _| Ok(()),
     )
     .unwrap();

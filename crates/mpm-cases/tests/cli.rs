@@ -24,7 +24,13 @@ fn temp_dir(name: &str) -> PathBuf {
 
 fn no_nan_in(dir: &Path) {
     for entry in std::fs::read_dir(dir).unwrap() {
-        let text = std::fs::read_to_string(entry.unwrap().path()).unwrap();
+        let path = entry.unwrap().path();
+        if path.file_name().unwrap() == "checkpoint.mpm" {
+            // Binary; its writer refuses non-finite numbers (tested in
+            // resume_repeats_the_uninterrupted_run).
+            continue;
+        }
+        let text = std::fs::read_to_string(path).unwrap();
         let lower = text.to_lowercase();
         assert!(
             !lower.contains("nan") && !lower.contains("inf"),
@@ -200,4 +206,134 @@ fn non_convergence_and_points_leaving_the_grid_are_diagnosed() {
     assert!(!err.contains("panicked"), "{err}");
     no_nan_in(&dir);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every file of `dir` except the checkpoint and `summary.json` (whose wall
+/// time differs), by name.
+fn outputs(dir: &Path) -> std::collections::BTreeMap<String, String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let name = p.file_name().unwrap().to_str().unwrap();
+            name != "checkpoint.mpm" && name != "summary.json"
+        })
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_str().unwrap().to_string(),
+                std::fs::read_to_string(&p).unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn resume_repeats_the_uninterrupted_run() {
+    // The shear case uses the secant predictor, whose memory must survive
+    // the checkpoint; the cantilever writes a case table (tip.csv).
+    for (case, steps) in [("shear", "30"), ("cantilever", "50")] {
+        let whole = temp_dir(&format!("whole-{case}"));
+        let split = temp_dir(&format!("split-{case}"));
+        let args = |dir: &Path| {
+            vec![
+                "run".to_string(),
+                "--case".into(),
+                case.into(),
+                "--set".into(),
+                "load_steps=".to_string() + steps,
+                "--out".into(),
+                dir.to_str().unwrap().to_string(),
+            ]
+        };
+        let run = |extra: &[&str], dir: &Path| {
+            let mut a: Vec<String> = args(dir);
+            a.extend(extra.iter().map(|s| s.to_string()));
+            let a: Vec<&str> = a.iter().map(String::as_str).collect();
+            mpm(&a)
+        };
+        let (ok, _, err) = run(&[], &whole);
+        assert!(ok, "{err}");
+        let (ok, out, err) = run(&["--stop-after", "7"], &split);
+        assert!(ok, "{err}");
+        assert!(out.contains("stopped after load step 7"), "{out}");
+        assert!(!split.join("summary.json").exists());
+        let (ok, out, err) = run(&["--resume", "--stop-after", "9"], &split);
+        assert!(
+            ok && out.contains("stopped after load step 16"),
+            "{out}{err}"
+        );
+        let (ok, _, err) = run(&["--resume"], &split);
+        assert!(ok, "{err}");
+        let (a, b) = (outputs(&whole), outputs(&split));
+        assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+        for (name, text) in &a {
+            assert!(text == &b[name], "{case}: {name} differs after resuming");
+        }
+        let summary = |dir: &Path| -> serde_json::Value {
+            let mut v: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())
+                    .unwrap();
+            v.as_object_mut().unwrap().remove("wall_time_s");
+            v
+        };
+        assert_eq!(summary(&whole), summary(&split), "{case}");
+        no_nan_in(&split);
+    }
+}
+
+#[test]
+fn resume_refuses_another_scene_a_missing_or_a_damaged_checkpoint() {
+    let dir = temp_dir("resume-errors");
+    let (ok, _, err) = mpm(&[
+        "run",
+        "--case",
+        "column",
+        "--resume",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("checkpoint.mpm"), "{err}");
+    let (ok, _, err) = mpm(&[
+        "run",
+        "--case",
+        "column",
+        "--stop-after",
+        "3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = mpm(&[
+        "run",
+        "--case",
+        "column",
+        "--set",
+        "h=1.5625",
+        "--resume",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("other parameters"), "{err}");
+    let (ok, _, err) = mpm(&[
+        "run",
+        "--case",
+        "cantilever",
+        "--resume",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("case `column`"), "{err}");
+    let path = dir.join("checkpoint.mpm");
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::write(&path, &bytes[..bytes.len() - 8]).unwrap();
+    let (ok, _, err) = mpm(&[
+        "run",
+        "--case",
+        "column",
+        "--resume",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("not a usable checkpoint"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
 }

@@ -2,6 +2,7 @@
 #![allow(clippy::unwrap_used)]
 
 use mpm_cases::cases::collapse::{CollapseParams, run};
+use mpm_cases::run::RunControl;
 use mpm_cases::variant::Variant;
 
 /// Table 6, h = 1.0 m: (points per cell per direction, horizontal extent,
@@ -16,7 +17,13 @@ fn standard_mpm_collapse_reproduces_table_6_within_one_percent() {
             points_per_cell: ppc,
             ..CollapseParams::default()
         };
-        let r = run(&p, &Variant::default(), |_, _, _| Ok(())).unwrap();
+        let r = run(
+            &p,
+            &Variant::default(),
+            &RunControl::default(),
+            |_, _, _| Ok(()),
+        )
+        .unwrap();
         let (e_ext, e_h) = (
             (r.horizontal_extent - extent) / extent,
             (r.max_height - height) / height,

@@ -2,6 +2,7 @@
 #![allow(clippy::unwrap_used)]
 
 use mpm_cases::cases::column::{ColumnParams, run};
+use mpm_cases::run::RunControl;
 use mpm_cases::variant::{BasisKind, DomainUpdateKind, FormulationKind};
 
 fn params(
@@ -30,8 +31,14 @@ fn updated_lagrangian_equals_previously_converged() {
     ] {
         let pc_p = params(4, basis, FormulationKind::Pc, update);
         let ul_p = params(4, basis, FormulationKind::Ul, update);
-        let pc = run(&pc_p, &pc_p.variant(), |_, _, _| Ok(())).unwrap();
-        let ul = run(&ul_p, &ul_p.variant(), |_, _, _| Ok(())).unwrap();
+        let pc = run(&pc_p, &pc_p.variant(), &RunControl::default(), |_, _, _| {
+            Ok(())
+        })
+        .unwrap();
+        let ul = run(&ul_p, &ul_p.variant(), &RunControl::default(), |_, _, _| {
+            Ok(())
+        })
+        .unwrap();
         let smax = pc
             .output
             .last
@@ -80,7 +87,7 @@ fn gimp_converges_with_grid_refinement_and_standard_mpm_stagnates() {
             FormulationKind::Pc,
             DomainUpdateKind::Stretch,
         );
-        let r = run(&p, &p.variant(), |_, _, _| Ok(())).unwrap();
+        let r = run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap();
         println!(
             "gimp k={k}: error {:.4e}, {} iterations",
             r.error, r.output.summary.iterations
@@ -110,10 +117,19 @@ fn gimp_converges_with_grid_refinement_and_standard_mpm_stagnates() {
         DomainUpdateKind::None,
     );
     let (c, f) = (
-        run(&coarse, &coarse.variant(), |_, _, _| Ok(()))
-            .unwrap()
-            .error,
-        run(&fine, &fine.variant(), |_, _, _| Ok(())).unwrap().error,
+        run(
+            &coarse,
+            &coarse.variant(),
+            &RunControl::default(),
+            |_, _, _| Ok(()),
+        )
+        .unwrap()
+        .error,
+        run(&fine, &fine.variant(), &RunControl::default(), |_, _, _| {
+            Ok(())
+        })
+        .unwrap()
+        .error,
     );
     println!("standard MPM 2x2: k=3 {c:.3e}, k=6 {f:.3e}");
     assert!(f > 0.5 * c, "standard MPM with 2x2 points should stagnate");
@@ -125,7 +141,7 @@ fn bad_grid_size_is_a_clear_error() {
         h: 3.0,
         ..ColumnParams::default()
     };
-    let err = run(&p, &p.variant(), |_, _, _| Ok(())).unwrap_err();
+    let err = run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap_err();
     assert!(
         err.to_string().contains("must divide the column height"),
         "{err}"
@@ -135,6 +151,6 @@ fn bad_grid_size_is_a_clear_error() {
         domain_update: DomainUpdateKind::Stretch,
         ..ColumnParams::default()
     };
-    let err = run(&p, &p.variant(), |_, _, _| Ok(())).unwrap_err();
+    let err = run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap_err();
     assert!(err.to_string().contains("needs basis = gimp"), "{err}");
 }

@@ -78,6 +78,16 @@ pub enum SolverError {
         /// The basis error.
         reason: String,
     },
+    /// The observer asked the run to stop after a converged step (e.g. a
+    /// step budget); the state after that step is complete and a
+    /// checkpoint written then can be resumed.
+    #[error("stopped after load step {step} at load factor {load_factor}")]
+    Stopped {
+        /// Converged steps so far.
+        step: usize,
+        /// Load factor reached.
+        load_factor: f64,
+    },
     /// Inconsistent problem set-up.
     #[error("invalid input: {0}")]
     InvalidInput(String),

@@ -202,7 +202,7 @@ where
 impl<const D: usize, B, F, L, K, U, C> ImplicitSolver<D, B, F, L, K, U, C>
 where
     B: BasisFunction<D>,
-    B::Mesh: NodalMesh,
+    B::Mesh: NodalMesh<D>,
     F: Formulation,
     L: LogStrainLaw,
     K: LockingTreatment,
@@ -450,6 +450,36 @@ where
                 self.it.du[dof] = scale * previous[mesh_dof];
             }
         }
+    }
+
+    /// The secant predictor's memory: the last converged increment per mesh
+    /// dof and its load increment ([`NewtonOptions::predictor`]); `None`
+    /// before the first step or with the predictor off. Saved with a
+    /// checkpoint so that a resumed run repeats the uninterrupted one.
+    pub fn predictor_state(&self) -> Option<(&[f64], f64)> {
+        self.previous.as_ref().map(|(u, dl)| (u.as_slice(), *dl))
+    }
+
+    /// Restores [`Self::predictor_state`].
+    ///
+    /// # Errors
+    /// [`SolverError::InvalidInput`] if the increment does not have one
+    /// entry per mesh dof or is not finite.
+    pub fn set_predictor_state(
+        &mut self,
+        state: Option<(Vec<f64>, f64)>,
+    ) -> Result<(), SolverError> {
+        if let Some((u, dl)) = &state {
+            let n = D * self.mesh.node_count();
+            if u.len() != n || !u.iter().all(|x| x.is_finite()) || !(dl.is_finite() && *dl > 0.0) {
+                return Err(SolverError::InvalidInput(format!(
+                    "predictor state has {} finite-checked entries for {n} mesh dofs and load increment {dl}",
+                    u.len()
+                )));
+            }
+        }
+        self.previous = state;
+        Ok(())
     }
 
     /// Stores the converged increment per mesh dof for the predictor.
@@ -789,18 +819,22 @@ where
 
     /// The converged grid displacement increment interpolated at `x` (a
     /// point of the configuration at the start of the step) with the
-    /// step's active nodes; used by domain updates that convect corners.
+    /// background mesh's own linear shape functions,
+    /// $\Delta\mathbf u(\mathbf x) = \sum_v N_v(\mathbf x)\Delta\mathbf u_v$
+    /// (eq. 35); used by domain updates that convect corners or mid-points.
+    /// Nodes outside the step's active set may appear only with a zero
+    /// value (a corner on the face of a cell the domain does not enter).
     fn displacement_at(
         &self,
         x: &SVector<f64, D>,
-        domain: &B::Domain,
         stencil: &mut Stencil<D>,
     ) -> Result<SVector<f64, D>, DomainError> {
-        self.basis
-            .evaluate(&self.mesh, x, domain, stencil)
+        self.mesh
+            .shape_functions(x, stencil)
             .map_err(|e| DomainError(e.to_string()))?;
         let mut u = SVector::<f64, D>::zeros();
         for (a, &node) in stencil.nodes.iter().enumerate() {
+            let value = stencil.values[a];
             let v = self
                 .system
                 .active_of_mesh
@@ -808,13 +842,16 @@ where
                 .copied()
                 .unwrap_or(NONE);
             if v == NONE {
+                if value == 0.0 {
+                    continue;
+                }
                 return Err(DomainError(format!(
                     "node {node} near {:?} is not active",
                     x.as_slice()
                 )));
             }
             for i in 0..D {
-                u[i] += stencil.values[a] * self.it.du[D * v as usize + i];
+                u[i] += value * self.it.du[D * v as usize + i];
             }
         }
         Ok(u)
@@ -827,7 +864,7 @@ where
         points: &mut MaterialPoints<D, L::History, B::Domain>,
     ) -> Result<(), SolverError> {
         let n = points.len();
-        let stencil = std::cell::RefCell::new(Stencil::<D>::with_capacity(B::MAX_NODES));
+        let stencil = std::cell::RefCell::new(Stencil::<D>::with_capacity(1 << D));
         for p in 0..n {
             let Some(r) = self.it.responses[p].as_ref() else {
                 continue;
@@ -851,21 +888,19 @@ where
             };
             let domain = self
                 .updater
-                .update(&ctx, |x| {
-                    self.displacement_at(x, &points.domain[p], &mut stencil.borrow_mut())
-                })
+                .update(&ctx, |x| self.displacement_at(x, &mut stencil.borrow_mut()))
                 .map_err(|e| SolverError::DomainUpdate {
                     point: p,
                     reason: e.0,
                 })?;
             points.position[p] = position;
             points.displacement[p] += du;
-            points.domain[p] = domain;
             points.f[p] = r.f;
             points.be[p] = r.state.be;
             points.history[p] = r.state.history;
             points.sigma[p] = r.sigma;
-            points.volume[p] = r.j * points.volume0[p];
+            points.volume[p] = self.updater.volume(&domain, r.j * points.volume0[p]);
+            points.domain[p] = domain;
         }
         Ok(())
     }
@@ -903,7 +938,7 @@ where
 impl<const D: usize, B, F, L, K, U, C> ImplicitSolver<D, B, F, L, K, U, C>
 where
     B: BasisFunction<D>,
-    B::Mesh: NodalMesh,
+    B::Mesh: NodalMesh<D>,
     F: Formulation,
     L: LogStrainLaw,
     K: LockingTreatment,

@@ -10,6 +10,7 @@
 //! [`run`] drives it through load steps with automatic step control.
 
 pub mod boundary;
+pub mod checkpoint;
 pub mod domain;
 pub mod error;
 pub mod formulation;
@@ -22,6 +23,7 @@ pub mod stepping;
 pub mod system;
 
 pub use boundary::{Constraints, NodalConstraints};
+pub use checkpoint::Flat;
 pub use domain::{DomainContext, DomainError, DomainUpdater, NoUpdate, StretchU};
 pub use error::{SolverError, StepFailure};
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
@@ -30,4 +32,4 @@ pub use linear::{Factorisation, LinearSolver};
 pub use locking::{LockingTreatment, NoLocking};
 pub use mesh::NodalMesh;
 pub use points::MaterialPoints;
-pub use stepping::{LoadStepping, RunSummary};
+pub use stepping::{LoadStepping, RunState, RunSummary, StepContext};

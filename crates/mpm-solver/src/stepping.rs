@@ -40,8 +40,42 @@ impl LoadStepping {
     }
 }
 
+/// Where an analysis stands between two load steps: enough, together with
+/// the material points and [`ImplicitSolver::predictor_state`], to resume
+/// it with the same results as an uninterrupted run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunState {
+    /// Load factor reached.
+    pub load_factor: f64,
+    /// Increment the next step will try.
+    pub increment: f64,
+    /// Counters so far.
+    pub summary: RunSummary,
+}
+
+impl RunState {
+    /// The start of an analysis.
+    pub fn start(stepping: &LoadStepping) -> Self {
+        Self {
+            load_factor: 0.0,
+            increment: stepping.initial,
+            summary: RunSummary::default(),
+        }
+    }
+}
+
+/// What the observer of [`ImplicitSolver::run_from`] learns besides the
+/// step report and the points: the state to resume from.
+#[derive(Debug, Clone, Copy)]
+pub struct StepContext<'a> {
+    /// Load stepping state after the step.
+    pub state: RunState,
+    /// [`ImplicitSolver::predictor_state`] after the step.
+    pub predictor: Option<(&'a [f64], f64)>,
+}
+
 /// What a whole analysis did.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct RunSummary {
     /// Converged load steps.
     pub steps: usize,
@@ -54,7 +88,7 @@ pub struct RunSummary {
 impl<const D: usize, B, F, L, K, U, C> ImplicitSolver<D, B, F, L, K, U, C>
 where
     B: BasisFunction<D>,
-    B::Mesh: NodalMesh,
+    B::Mesh: NodalMesh<D>,
     F: Formulation,
     L: LogStrainLaw,
     K: LockingTreatment,
@@ -77,6 +111,29 @@ where
             &MaterialPoints<D, L::History, B::Domain>,
         ) -> Result<(), SolverError>,
     {
+        self.run_from(points, stepping, RunState::start(stepping), |s, r, p, _| {
+            observer(s, r, p)
+        })
+    }
+
+    /// Runs the analysis from `state` (for example one saved by a
+    /// checkpoint) to load factor 1. The observer also receives the state
+    /// after the step, from which the run can later be resumed.
+    pub fn run_from<O>(
+        &mut self,
+        points: &mut MaterialPoints<D, L::History, B::Domain>,
+        stepping: &LoadStepping,
+        state: RunState,
+        mut observer: O,
+    ) -> Result<RunSummary, SolverError>
+    where
+        O: FnMut(
+            usize,
+            &StepReport<D>,
+            &MaterialPoints<D, L::History, B::Domain>,
+            &StepContext<'_>,
+        ) -> Result<(), SolverError>,
+    {
         if !(stepping.min > 0.0
             && stepping.min <= stepping.initial
             && stepping.initial <= stepping.max)
@@ -85,9 +142,17 @@ where
                 "load stepping needs 0 < min <= initial <= max, got {stepping:?}"
             )));
         }
-        let mut summary = RunSummary::default();
-        let mut lambda = 0.0f64;
-        let mut increment = stepping.initial;
+        if !(state.load_factor.is_finite()
+            && (0.0..=1.0).contains(&state.load_factor)
+            && state.increment > 0.0)
+        {
+            return Err(SolverError::InvalidInput(format!(
+                "cannot resume from {state:?}: need 0 <= load factor <= 1 and a positive increment"
+            )));
+        }
+        let mut summary = state.summary;
+        let mut lambda = state.load_factor;
+        let mut increment = state.increment.min(stepping.max);
         const END: f64 = 1.0 - 1e-12;
         while lambda < END {
             let target = (lambda + increment).min(1.0);
@@ -96,8 +161,17 @@ where
                     summary.steps += 1;
                     summary.iterations += report.iterations();
                     lambda = target;
-                    observer(summary.steps - 1, &report, points)?;
                     increment = (2.0 * increment).min(stepping.max);
+                    let now = RunState {
+                        load_factor: lambda,
+                        increment,
+                        summary,
+                    };
+                    let context = StepContext {
+                        state: now,
+                        predictor: self.predictor_state(),
+                    };
+                    observer(summary.steps - 1, &report, points, &context)?;
                 }
                 Err(StepError::Fatal(e)) => return Err(e),
                 Err(StepError::Retry {

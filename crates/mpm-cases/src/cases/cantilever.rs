@@ -12,13 +12,13 @@
 use mpm_constitutive::HenckyElastic;
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    DomainUpdater, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
+    DomainUpdater, Flat, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
     StepReport,
 };
 use nalgebra::SVector;
 
 use crate::body::{Body, InitialDomain};
-use crate::run::{Loads, RunOutput, Setup, Snapshot, simulate};
+use crate::run::{Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
 crate::case_params! {
@@ -121,8 +121,15 @@ pub fn geometry(
     }
 }
 
+/// The tip displacement: the mean displacement of the two loaded points.
+pub fn tip_displacement(snap: &Snapshot, loaded: [usize; 2]) -> (f64, f64) {
+    let (a, b) = (&snap.displacement[loaded[0]], &snap.displacement[loaded[1]]);
+    (0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]))
+}
+
 struct CantileverRun<'a, O> {
     params: &'a CantileverParams,
+    control: &'a RunControl,
     observer: O,
 }
 
@@ -134,7 +141,7 @@ where
 
     fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
     where
-        B: InitialDomain<2, Mesh = RegularGrid<2>>,
+        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat>,
         F: Formulation,
         U: DomainUpdater<2, B::Domain>,
     {
@@ -161,12 +168,17 @@ where
         };
         let mut tip = Vec::new();
         let mut observer = self.observer;
-        let output =
-            simulate::<2, B, F, U, _, _, _>(setup, basis, updater, |step, report, snap| {
-                let (a, b) = (&snap.displacement[loaded[0]], &snap.displacement[loaded[1]]);
-                tip.push((report.lambda1, 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])));
+        let output = simulate::<2, B, F, U, _, _, _>(
+            setup,
+            basis,
+            updater,
+            self.control,
+            |step, report, snap| {
+                let (ux, uy) = tip_displacement(snap, loaded);
+                tip.push((report.lambda1, ux, uy));
                 observer(step, report, snap)
-            })?;
+            },
+        )?;
         Ok(CantileverResult {
             output,
             tip,
@@ -179,10 +191,19 @@ where
 pub fn run<O>(
     params: &CantileverParams,
     variant: &Variant,
+    control: &RunControl,
     observer: O,
 ) -> Result<CantileverResult, SolverError>
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    dispatch(variant, CantileverRun { params, observer }).map_err(SolverError::InvalidInput)?
+    dispatch(
+        variant,
+        CantileverRun {
+            params,
+            control,
+            observer,
+        },
+    )
+    .map_err(SolverError::InvalidInput)?
 }

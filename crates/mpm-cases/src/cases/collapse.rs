@@ -17,13 +17,13 @@
 use mpm_constitutive::VonMises;
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    DomainUpdater, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
+    DomainUpdater, Flat, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
     StepReport,
 };
 use nalgebra::SVector;
 
 use crate::body::{Body, InitialDomain};
-use crate::run::{Loads, RunOutput, Setup, Snapshot, simulate};
+use crate::run::{Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
 crate::case_params! {
@@ -121,6 +121,7 @@ pub fn geometry(
 
 struct CollapseRun<'a, O> {
     params: &'a CollapseParams,
+    control: &'a RunControl,
     observer: O,
 }
 
@@ -132,7 +133,7 @@ where
 
     fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
     where
-        B: InitialDomain<2, Mesh = RegularGrid<2>>,
+        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat>,
         F: Formulation,
         U: DomainUpdater<2, B::Domain>,
     {
@@ -157,7 +158,8 @@ where
                 ..NewtonOptions::default()
             },
         };
-        let output = simulate::<2, B, F, U, _, _, _>(setup, basis, updater, self.observer)?;
+        let output =
+            simulate::<2, B, F, U, _, _, _>(setup, basis, updater, self.control, self.observer)?;
         let edge = |axis: usize| {
             output
                 .last
@@ -181,10 +183,19 @@ where
 pub fn run<O>(
     params: &CollapseParams,
     variant: &Variant,
+    control: &RunControl,
     observer: O,
 ) -> Result<CollapseResult, SolverError>
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    dispatch(variant, CollapseRun { params, observer }).map_err(SolverError::InvalidInput)?
+    dispatch(
+        variant,
+        CollapseRun {
+            params,
+            control,
+            observer,
+        },
+    )
+    .map_err(SolverError::InvalidInput)?
 }

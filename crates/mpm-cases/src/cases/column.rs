@@ -11,12 +11,12 @@
 use mpm_constitutive::HenckyElastic;
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    DomainUpdater, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
+    DomainUpdater, Flat, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
 };
 use nalgebra::SVector;
 
 use crate::body::{Body, InitialDomain};
-use crate::run::{Loads, RunOutput, Setup, Snapshot, simulate};
+use crate::run::{Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
 crate::case_params! {
@@ -119,6 +119,7 @@ pub fn geometry(
 
 struct ColumnRun<'a, O> {
     params: &'a ColumnParams,
+    control: &'a RunControl,
     observer: O,
 }
 
@@ -130,7 +131,7 @@ where
 
     fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
     where
-        B: InitialDomain<2, Mesh = RegularGrid<2>>,
+        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat>,
         F: Formulation,
         U: DomainUpdater<2, B::Domain>,
     {
@@ -154,7 +155,8 @@ where
                 ..NewtonOptions::default()
             },
         };
-        let output = simulate::<2, B, F, U, _, _, _>(setup, basis, updater, self.observer)?;
+        let output =
+            simulate::<2, B, F, U, _, _, _>(setup, basis, updater, self.control, self.observer)?;
         let z0: Vec<f64> = body.position.iter().map(|x| x[1]).collect();
         let error = p.error(&output.last, &z0, &body.volume);
         Ok(ColumnResult {
@@ -169,10 +171,19 @@ where
 pub fn run<O>(
     params: &ColumnParams,
     variant: &Variant,
+    control: &RunControl,
     observer: O,
 ) -> Result<ColumnResult, SolverError>
 where
     O: FnMut(usize, &mpm_solver::StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    dispatch(variant, ColumnRun { params, observer }).map_err(SolverError::InvalidInput)?
+    dispatch(
+        variant,
+        ColumnRun {
+            params,
+            control,
+            observer,
+        },
+    )
+    .map_err(SolverError::InvalidInput)?
 }

@@ -41,12 +41,15 @@ use mpm_constitutive::{
 };
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    Constraints, DomainUpdater, Formulation, LoadStepping, NewtonOptions, SolverError, StepReport,
+    Constraints, DomainUpdater, Flat, Formulation, LoadStepping, NewtonOptions, SolverError,
+    StepReport,
 };
 use nalgebra::{Matrix2, Matrix3, SVector};
 
 use crate::body::{Body, InitialDomain};
-use crate::run::{HistoryOutput, Loads, RunOutput, Setup, Snapshot, simulate};
+use crate::run::{
+    Checkpoint, HistoryOutput, Loads, RunControl, RunOutput, Setup, Snapshot, simulate,
+};
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
 crate::case_params! {
@@ -146,6 +149,33 @@ pub struct SinglePoint<L: LogStrainLaw> {
     state: MaterialState<L::History>,
 }
 
+impl<L: LogStrainLaw> SinglePoint<L>
+where
+    L::History: Flat,
+{
+    /// The state as numbers: F, b^e, history.
+    fn save(&self, out: &mut Vec<f64>) {
+        self.f.write(out);
+        self.state.be.write(out);
+        self.state.history.write(out);
+    }
+
+    /// Restores [`Self::save`]'s numbers.
+    fn restore(&mut self, from: &[f64]) -> Result<(), SolverError> {
+        if from.len() != 18 + L::History::LEN {
+            return Err(SolverError::InvalidInput(format!(
+                "the checkpoint's shear reference has {} numbers, expected {}",
+                from.len(),
+                18 + L::History::LEN
+            )));
+        }
+        self.f = Matrix3::read(&from[..9]);
+        self.state.be = Matrix3::read(&from[9..18]);
+        self.state.history = L::History::read(&from[18..]);
+        Ok(())
+    }
+}
+
 impl<L: LogStrainLaw> SinglePoint<L> {
     /// An unstrained point.
     pub fn new(law: L) -> Self {
@@ -207,6 +237,7 @@ pub fn grid(p: &ShearParams, pad: usize) -> Result<RegularGrid<2>, SolverError> 
 
 struct ShearRun<'a, O> {
     params: &'a ShearParams,
+    control: &'a RunControl,
     observer: O,
 }
 
@@ -216,11 +247,11 @@ where
 {
     fn go<B, F, U, L>(self, basis: B, updater: U, law: L) -> Result<ShearResult, SolverError>
     where
-        B: InitialDomain<2, Mesh = RegularGrid<2>>,
+        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat>,
         F: Formulation,
         U: DomainUpdater<2, B::Domain>,
         L: LogStrainLaw + Clone,
-        L::History: HistoryOutput,
+        L::History: HistoryOutput + Flat,
     {
         let p = self.params;
         let grid = grid(p, B::PADDING)?;
@@ -265,19 +296,44 @@ where
                 ..NewtonOptions::default()
             },
         };
+        // On resume: the largest error so far and the reference's state.
         let mut error = 0.0f64;
+        if let Some(c) = &self.control.resume {
+            let (first, rest) = c.case_state.split_first().ok_or_else(|| {
+                SolverError::InvalidInput("the checkpoint has no shear reference".into())
+            })?;
+            error = *first;
+            reference.restore(rest)?;
+        }
         let mut observer = self.observer;
-        let output =
-            simulate::<2, B, F, U, _, _, _>(setup, basis, updater, |step, report, snap| {
+        let output = simulate::<2, B, F, U, _, _, _>(
+            setup,
+            basis,
+            updater,
+            self.control,
+            |step, report, snap| {
                 // The reference follows the increments actually taken (a cut
                 // step changes the plastic path).
-                let reference = reference.shear(p.shear * (report.lambda1 - report.lambda0))?;
+                let sigma_ref = reference.shear(p.shear * (report.lambda1 - report.lambda0))?;
                 for s in &snap.sigma {
                     let sigma = Matrix3::from_row_slice(s);
-                    error = error.max((sigma - reference).norm() / reference.norm());
+                    error = error.max((sigma - sigma_ref).norm() / sigma_ref.norm());
                 }
-                observer(step, report, snap)
-            })?;
+                match &snap.checkpoint {
+                    Some(c) => {
+                        let mut case_state = vec![error];
+                        reference.save(&mut case_state);
+                        let mut snap = snap.clone();
+                        snap.checkpoint = Some(Checkpoint {
+                            case_state,
+                            ..c.clone()
+                        });
+                        observer(step, report, &snap)
+                    }
+                    None => observer(step, report, snap),
+                }
+            },
+        )?;
         Ok(ShearResult {
             output,
             error,
@@ -294,7 +350,7 @@ where
 
     fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
     where
-        B: InitialDomain<2, Mesh = RegularGrid<2>>,
+        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat>,
         F: Formulation,
         U: DomainUpdater<2, B::Domain>,
     {
@@ -319,10 +375,19 @@ where
 pub fn run<O>(
     params: &ShearParams,
     variant: &Variant,
+    control: &RunControl,
     observer: O,
 ) -> Result<ShearResult, SolverError>
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    dispatch(variant, ShearRun { params, observer }).map_err(SolverError::InvalidInput)?
+    dispatch(
+        variant,
+        ShearRun {
+            params,
+            control,
+            observer,
+        },
+    )
+    .map_err(SolverError::InvalidInput)?
 }

@@ -76,7 +76,7 @@ impl From<String> for CsvValue<'_> {
 }
 
 /// A CSV table: a header and rows of the same width.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct CsvTable {
     header: Vec<String>,
     /// Rows, already encoded as CSV lines without the line break.

@@ -13,7 +13,7 @@ use crate::CasesError;
 
 /// One step of a series: its time and the data file, as written into the
 /// `.pvd` (relative to the collection's directory where possible).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PvdStep {
     /// The step's time.
     pub time: f64,
@@ -36,6 +36,15 @@ impl PvdSeries {
         Self {
             path: path.into(),
             steps: Vec::new(),
+        }
+    }
+    /// A collection at `path` that already lists `steps` (a resumed run);
+    /// nothing is written until the next [`PvdSeries::push`].
+    #[must_use]
+    pub fn with_steps(path: impl Into<PathBuf>, steps: Vec<PvdStep>) -> Self {
+        Self {
+            path: path.into(),
+            steps,
         }
     }
 
