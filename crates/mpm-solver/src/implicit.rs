@@ -1016,6 +1016,20 @@ where
         Ok(self.normalised_residual())
     }
 
+    /// The current increment at the free dofs (after a converged step: the
+    /// converged increment of that step), in the numbering of
+    /// [`Self::prepare_step`].
+    pub fn free_increment(&self) -> Vec<f64> {
+        let sys = &self.system;
+        let mut du = vec![0.0; sys.n_free];
+        for (dof, &free) in sys.free_of_dof.iter().enumerate() {
+            if free != NONE {
+                du[free as usize] = self.it.du[dof];
+            }
+        }
+        du
+    }
+
     fn set_free_increment(&mut self, du_free: &[f64]) {
         let sys = &self.system;
         for (dof, &free) in sys.free_of_dof.iter().enumerate() {
