@@ -39,6 +39,22 @@ pub trait BasisFunction<const D: usize>: Send + Sync {
         out: &mut Stencil<D>,
     ) -> Result<(), BasisError>;
 
+    /// Like [`evaluate`](Self::evaluate), with a per-point cell hint: a basis on an unstructured mesh starts its point location (walking, Wang et al. 2021 Algorithm 1) at `*hint` and writes the cell it found there; bases on regular grids ignore it. `usize::MAX` means "no hint".
+    ///
+    /// # Errors
+    /// As [`evaluate`](Self::evaluate).
+    fn evaluate_hinted(
+        &self,
+        mesh: &Self::Mesh,
+        position: &SVector<f64, D>,
+        domain: &Self::Domain,
+        hint: &mut usize,
+        out: &mut Stencil<D>,
+    ) -> Result<(), BasisError> {
+        let _ = hint;
+        self.evaluate(mesh, position, domain, out)
+    }
+
     /// An empty stencil with room for [`BasisFunction::MAX_NODES`] nodes.
     fn new_stencil(&self) -> Stencil<D> {
         Stencil::with_capacity(Self::MAX_NODES)

@@ -5,8 +5,9 @@
 //! gradients $\partial S_{vp}/\partial\tilde X$ into a caller-owned
 //! [`Stencil`], so that nothing allocates per material point. The mesh and
 //! the per-point domain are associated types. Implementations, one file
-//! each, all on [`mpm_mesh::RegularGrid<D>`] with one code path for 2D and
-//! 3D (`const D: usize`):
+//! each, on [`mpm_mesh::RegularGrid<D>`] (the last on
+//! [`mpm_mesh::SimplexMesh<D>`]) with one code path for 2D and 3D
+//! (`const D: usize`):
 //!
 //! | type | domain | nodes (2D / 3D) | source |
 //! |---|---|---|---|
@@ -14,6 +15,7 @@
 //! | [`Gimp`] | half-lengths `SVector<f64, D>` | 9 / 27 | Bardenhagen & Kober 2004; Charlton et al. 2017 |
 //! | [`Cpdi2`] | [`Corners<D>`] | ≤ 16 / ≤ 64 | Sadeghirad et al. 2013 (corrected, Coombs et al. 2020 fn. 6) |
 //! | [`QuadraticBSpline`] | `()` | 9 / 27 | Steffen et al. 2008; MPoint notes eqs. 24–27 |
+//! | [`LinearSimplex`] | `()` | 3 / 4 | Wang et al. 2021 §2.3, eqs. 13–15 (on [`mpm_mesh::SimplexMesh`]) |
 //!
 //! Tensor-product bases are assembled from 1D factors by one loop over the
 //! axes. Every failure is a [`BasisError`] naming the point; a node beyond
@@ -39,6 +41,7 @@ mod cpdi2;
 mod error;
 mod gimp;
 mod linear_mpm;
+mod linear_simplex;
 mod quadratic_bspline;
 mod stencil;
 mod tensor;
@@ -49,5 +52,6 @@ pub use cpdi2::{Cpdi2, DomainIntegrals};
 pub use error::BasisError;
 pub use gimp::Gimp;
 pub use linear_mpm::LinearMpm;
+pub use linear_simplex::LinearSimplex;
 pub use quadratic_bspline::QuadraticBSpline;
 pub use stencil::Stencil;

@@ -1,12 +1,14 @@
 //! Property tests run for every basis in 2D and 3D by one macro: partition
 //! of unity, zero gradient sum, linear reproduction, gradients against
-//! finite differences, and well-formed stencils (no node outside the grid).
+//! finite differences, well-formed stencils (no node outside the grid), and
+//! hinted evaluation agreeing with the plain one.
 #![allow(missing_docs)]
 
 mod common;
 
 use common::*;
-use mpm_basis::{Corners, Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
+use mpm_basis::{BasisFunction, Corners, Cpdi2, Gimp, LinearMpm, LinearSimplex, QuadraticBSpline};
+use mpm_mesh::SimplexMesh;
 use nalgebra::SVector;
 use proptest::prelude::*;
 
@@ -43,6 +45,11 @@ macro_rules! basis_properties {
                 fn stencil_is_well_formed_and_inside_the_grid((x, domain) in $cases) {
                     check_well_formed::<$dim, _>(&$basis, &x, &domain)?;
                 }
+
+                #[test]
+                fn hinted_evaluation_matches((x, domain) in $cases, seed in any::<usize>()) {
+                    check_hinted::<$dim, _>(&$basis, &x, &domain, seed)?;
+                }
             }
         }
     };
@@ -52,6 +59,23 @@ macro_rules! basis_properties {
 /// two steps of a node line (kink).
 fn linear_bound<const D: usize>(x: &SVector<f64, D>, _: &(), axis: usize) -> Option<f64> {
     (distance_to_node_line(axis, x[axis]) > 2.0 * fd_step(axis)).then_some(0.0)
+}
+
+/// Linear simplices: the values are linear inside an element; skip points
+/// whose ±2δ neighbourhood along `axis` leaves the element (a barycentric
+/// coordinate below 2δ times its gradient component).
+fn simplex_bound<const D: usize>(x: &SVector<f64, D>, _: &(), axis: usize) -> Option<f64>
+where
+    SimplexMesh<D>: TestMesh<D>,
+{
+    let mesh = SimplexMesh::<D>::test_mesh();
+    let mut stencil = mpm_basis::Stencil::for_basis::<LinearSimplex>();
+    LinearSimplex.evaluate(mesh, x, &(), &mut stencil).ok()?;
+    let margin = 2.0 * fd_step(axis);
+    stencil
+        .iter()
+        .all(|(_, value, gradient)| value > margin * gradient[axis].abs())
+        .then_some(0.0)
 }
 
 /// GIMP: $|S''| \le 1/(h^2\lambda)$ (the central region); with $\lambda = 0$
@@ -136,6 +160,20 @@ basis_properties!(
     linear_cases::<3>(),
     linear_bound::<3>
 );
+basis_properties!(
+    linear_simplex_2d,
+    LinearSimplex,
+    2,
+    linear_cases::<2>(),
+    simplex_bound::<2>
+);
+basis_properties!(
+    linear_simplex_3d,
+    LinearSimplex,
+    3,
+    linear_cases::<3>(),
+    simplex_bound::<3>
+);
 basis_properties!(gimp_2d, Gimp, 2, gimp_cases::<2>(), gimp_bound::<2>);
 basis_properties!(gimp_3d, Gimp, 3, gimp_cases::<3>(), gimp_bound::<3>);
 basis_properties!(cpdi2_2d, Cpdi2, 2, cpdi2_cases::<2>(), cpdi2_bound::<2>);
@@ -168,6 +206,24 @@ fn cpdi2_finite_difference_check_applies_to_in_cell_parallelograms() {
     for _ in 0..200 {
         let (x, c) = strategy.new_tree(&mut runner).expect("tree").current();
         if cpdi2_bound(&x, &c, 0).is_some() {
+            applicable += 1;
+        }
+    }
+    assert!(applicable >= 50, "only {applicable} of 200 cases checked");
+}
+
+/// The simplex finite-difference check must run on most cases: points off
+/// the node lines are mostly well inside an element.
+#[test]
+fn simplex_finite_difference_check_applies_inside_elements() {
+    use proptest::strategy::ValueTree;
+    use proptest::test_runner::TestRunner;
+    let mut runner = TestRunner::deterministic();
+    let strategy = linear_cases::<3>();
+    let mut applicable = 0;
+    for _ in 0..200 {
+        let (x, ()) = strategy.new_tree(&mut runner).expect("tree").current();
+        if (0..3).all(|axis| simplex_bound(&x, &(), axis).is_some()) {
             applicable += 1;
         }
     }

@@ -6,18 +6,41 @@
 //!   node sets per boundary [`Face`] for Dirichlet conditions, and the
 //!   active cells/nodes touched by material points or by the
 //!   [`BoundingBox`]es of their domains.
+//! - [`SimplexMesh`]: linear triangles and tetrahedra (Wang et al. 2021
+//!   §4.2) with the inverse element maps of eq. (13), the neighbour table
+//!   of Algorithm 2 and point location by walking (Algorithm 1,
+//!   [`SimplexMesh::locate`]) with a bucket-grid fallback.
+//! - [`QuadraticMesh`]: six-node triangles and ten-node tetrahedra, the
+//!   parents whose elements are the patches of the F-patch method;
+//!   [`PatchMesh`] splits them into linear children (§4.1, Fig. 3) and
+//!   lists the active elements of every patch ([`ActivePatches`]).
+//! - Generators: [`BoxMesh`] (structured, graded, [`DiagonalPattern`]) and
+//!   [`AnnulusMesh`]; a Gmsh MSH 4.1 ASCII reader ([`read_msh`],
+//!   [`parse_msh`]); physical groups and boundaries as [`NamedSets`].
 //! - [`MeshError`]: the crate's one error type; every variant names the
-//!   point, index or axis where it happened.
-//!
-//! Unstructured triangle/tetrahedral meshes (Wang et al. 2021 §4.2) will
-//! join this crate in a later issue.
+//!   point, index, element, axis or file line where it happened.
 
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 mod active;
 mod error;
+mod generate;
+mod gmsh;
+mod patches;
+mod quadratic;
 mod regular_grid;
+mod sets;
+mod simplex;
 
 pub use active::BoundingBox;
 pub use error::MeshError;
+pub use generate::{AnnulusMesh, BoxMesh, DiagonalPattern};
+pub use gmsh::{GmshElements, GmshMesh, parse_msh, read_msh};
+pub use patches::{ActivePatches, PatchMesh};
+pub use quadratic::QuadraticMesh;
 pub use regular_grid::{CellLocation, CellNodes, Face, RegularGrid, Side};
+pub use sets::{MeshSets, NamedSets};
+pub use simplex::{
+    BARYCENTRIC_TOLERANCE, BoundaryFace, Location, NO_NEIGHBOUR, SimplexMesh, Walk,
+    quadratic_node_count,
+};

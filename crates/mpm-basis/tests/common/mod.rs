@@ -1,11 +1,14 @@
-//! Shared fixtures for the basis tests: a test grid per dimension, point and
-//! domain strategies per basis, and the checks the property macro runs.
+//! Shared fixtures for the basis tests: a test grid per dimension (and a
+//! simplex mesh of the same box), point and domain strategies per basis,
+//! and the checks the property macro runs.
 #![allow(dead_code)]
 
 use std::fmt::Debug;
 
 use mpm_basis::{BasisFunction, Corners, Stencil};
-use mpm_mesh::RegularGrid;
+use std::sync::OnceLock;
+
+use mpm_mesh::{BoxMesh, DiagonalPattern, RegularGrid, SimplexMesh};
 use nalgebra::{SMatrix, SVector};
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
@@ -26,6 +29,75 @@ pub fn grid<const D: usize>() -> RegularGrid<D> {
     )
     .expect("valid test grid")
 }
+
+/// The test grid's box split into simplices (Kuhn split, alternating
+/// pattern): the same nodes, numbered the same way, as [`grid`].
+pub fn simplex_mesh<const D: usize>() -> SimplexMesh<D> {
+    let lower = SVector::from_fn(|i, _| ORIGIN[i]);
+    let upper = SVector::from_fn(|i, _| node_line(i, CELLS[i]));
+    BoxMesh::new(lower, upper, std::array::from_fn(|i| CELLS[i]))
+        .with_pattern(DiagonalPattern::Alternating)
+        .simplex_mesh()
+        .expect("valid test mesh")
+}
+
+/// What the checks need from a basis's mesh.
+pub trait TestMesh<const D: usize>: Sized + 'static {
+    /// The shared test mesh (built once).
+    fn test_mesh() -> &'static Self;
+    /// Number of nodes.
+    fn nodes(&self) -> usize;
+    /// Position of a node.
+    fn position(&self, node: usize) -> SVector<f64, D>;
+    /// Whether a point lies in the meshed region.
+    fn covers(&self, x: &SVector<f64, D>) -> bool;
+    /// Number of cells (for hints).
+    fn cells(&self) -> usize;
+}
+
+macro_rules! test_meshes {
+    ($($dim:literal),*) => {$(
+        impl TestMesh<$dim> for RegularGrid<$dim> {
+            fn test_mesh() -> &'static Self {
+                static MESH: OnceLock<RegularGrid<$dim>> = OnceLock::new();
+                MESH.get_or_init(grid::<$dim>)
+            }
+            fn nodes(&self) -> usize {
+                self.node_count()
+            }
+            fn position(&self, node: usize) -> SVector<f64, $dim> {
+                self.node_position(node).expect("node in grid")
+            }
+            fn covers(&self, x: &SVector<f64, $dim>) -> bool {
+                self.contains(x)
+            }
+            fn cells(&self) -> usize {
+                self.cell_count()
+            }
+        }
+
+        impl TestMesh<$dim> for SimplexMesh<$dim> {
+            fn test_mesh() -> &'static Self {
+                static MESH: OnceLock<SimplexMesh<$dim>> = OnceLock::new();
+                MESH.get_or_init(simplex_mesh::<$dim>)
+            }
+            fn nodes(&self) -> usize {
+                self.node_count()
+            }
+            fn position(&self, node: usize) -> SVector<f64, $dim> {
+                SimplexMesh::nodes(self)[node]
+            }
+            fn covers(&self, x: &SVector<f64, $dim>) -> bool {
+                self.locate_brute_force(x).is_ok()
+            }
+            fn cells(&self) -> usize {
+                self.element_count()
+            }
+        }
+    )*};
+}
+
+test_meshes!(2, 3);
 
 /// Coordinate of node line `k` along `axis` of the test grid.
 pub fn node_line(axis: usize, k: usize) -> f64 {
@@ -259,12 +331,13 @@ pub fn evaluate<const D: usize, B>(
     domain: &B::Domain,
 ) -> Result<Stencil<D>, TestCaseError>
 where
-    B: BasisFunction<D, Mesh = RegularGrid<D>>,
+    B: BasisFunction<D>,
+    B::Mesh: TestMesh<D>,
 {
     let mut stencil = Stencil::for_basis::<B>();
     let capacity = stencil.nodes.capacity();
     basis
-        .evaluate(&grid::<D>(), x, domain, &mut stencil)
+        .evaluate(B::Mesh::test_mesh(), x, domain, &mut stencil)
         .map_err(|e| TestCaseError::fail(format!("evaluation failed at {x:?}: {e}")))?;
     prop_assert_eq!(stencil.nodes.capacity(), capacity, "stencil reallocated");
     Ok(stencil)
@@ -297,7 +370,8 @@ pub fn check_partition<const D: usize, B>(
     domain: &B::Domain,
 ) -> Result<(), TestCaseError>
 where
-    B: BasisFunction<D, Mesh = RegularGrid<D>>,
+    B: BasisFunction<D>,
+    B::Mesh: TestMesh<D>,
 {
     let s = evaluate(basis, x, domain)?;
     let sum: f64 = s.values.iter().sum();
@@ -322,17 +396,18 @@ pub fn check_linear_reproduction<const D: usize, B>(
     domain: &B::Domain,
 ) -> Result<(), TestCaseError>
 where
-    B: BasisFunction<D, Mesh = RegularGrid<D>>,
+    B: BasisFunction<D>,
+    B::Mesh: TestMesh<D>,
     B::Domain: TestDomain<D>,
 {
-    let g = grid::<D>();
+    let g = B::Mesh::test_mesh();
     let s = evaluate(basis, x, domain)?;
     let mut reproduced = SVector::<f64, D>::zeros();
     let mut identity = SMatrix::<f64, D, D>::zeros();
     let mut value_scale = 0.0;
     let mut gradient_scale = 0.0;
     for (node, value, gradient) in s.iter() {
-        let xv = g.node_position(node).expect("node in grid");
+        let xv = g.position(node);
         reproduced += xv * value;
         identity += xv * gradient.transpose();
         value_scale += xv.norm() * value.abs();
@@ -368,7 +443,8 @@ pub fn check_finite_differences<const D: usize, B>(
     second_derivative_bound: impl Fn(&SVector<f64, D>, &B::Domain, usize) -> Option<f64>,
 ) -> Result<(), TestCaseError>
 where
-    B: BasisFunction<D, Mesh = RegularGrid<D>>,
+    B: BasisFunction<D>,
+    B::Mesh: TestMesh<D>,
     B::Domain: TestDomain<D>,
 {
     let s = evaluate(basis, x, domain)?;
@@ -416,9 +492,10 @@ pub fn check_well_formed<const D: usize, B>(
     domain: &B::Domain,
 ) -> Result<(), TestCaseError>
 where
-    B: BasisFunction<D, Mesh = RegularGrid<D>>,
+    B: BasisFunction<D>,
+    B::Mesh: TestMesh<D>,
 {
-    let g = grid::<D>();
+    let g = B::Mesh::test_mesh();
     let s = evaluate(basis, x, domain)?;
     prop_assert!(
         s.len() <= B::MAX_NODES,
@@ -430,8 +507,8 @@ where
     prop_assert_eq!(s.gradients.len(), s.len());
     prop_assert!(!s.is_empty());
     for (k, (node, value, gradient)) in s.iter().enumerate() {
-        prop_assert!(node < g.node_count(), "node {} outside the grid", node);
-        prop_assert!(g.contains(&g.node_position(node).expect("valid id")));
+        prop_assert!(node < g.nodes(), "node {} outside the grid", node);
+        prop_assert!(g.covers(&g.position(node)));
         prop_assert!(!s.nodes[..k].contains(&node), "node {} twice", node);
         prop_assert!(
             value.is_finite() && (-1e-15..=1.0 + 1e-15).contains(&value),
@@ -445,5 +522,64 @@ where
             node
         );
     }
+    Ok(())
+}
+
+/// A hinted evaluation ([`BasisFunction::evaluate_hinted`]) from the hint
+/// `seed % cells` (or no hint, `usize::MAX`, for every fifth seed) gives
+/// the values of the plain evaluation at every node (the values are
+/// continuous, whichever cell is found on a shared face), and the same
+/// gradients when it finds the same nodes; evaluating again from the hint
+/// it wrote reproduces the stencil exactly.
+pub fn check_hinted<const D: usize, B>(
+    basis: &B,
+    x: &SVector<f64, D>,
+    domain: &B::Domain,
+    seed: usize,
+) -> Result<(), TestCaseError>
+where
+    B: BasisFunction<D>,
+    B::Mesh: TestMesh<D>,
+{
+    let mesh = B::Mesh::test_mesh();
+    let plain = evaluate(basis, x, domain)?;
+    let mut hint = if seed.is_multiple_of(5) {
+        usize::MAX
+    } else {
+        seed % mesh.cells()
+    };
+    let mut hinted = Stencil::for_basis::<B>();
+    basis
+        .evaluate_hinted(mesh, x, domain, &mut hint, &mut hinted)
+        .map_err(|e| TestCaseError::fail(format!("hinted evaluation failed at {x:?}: {e}")))?;
+    for node in union_nodes(&plain, &hinted) {
+        let (a, b) = (value_of(&plain, node), value_of(&hinted, node));
+        prop_assert!(
+            (a - b).abs() <= 1e-12,
+            "node {}: value {} vs {}",
+            node,
+            a,
+            b
+        );
+    }
+    let mut same_nodes = plain.nodes.clone();
+    let mut hinted_nodes = hinted.nodes.clone();
+    same_nodes.sort_unstable();
+    hinted_nodes.sort_unstable();
+    if same_nodes == hinted_nodes {
+        for node in plain.nodes.iter().copied() {
+            let (a, b) = (gradient_of(&plain, node), gradient_of(&hinted, node));
+            prop_assert!(
+                (a - b).norm() <= 1e-12 * a.norm().max(1.0),
+                "node {} gradient",
+                node
+            );
+        }
+    }
+    let mut again = Stencil::for_basis::<B>();
+    basis
+        .evaluate_hinted(mesh, x, domain, &mut hint, &mut again)
+        .map_err(|e| TestCaseError::fail(format!("re-evaluation failed at {x:?}: {e}")))?;
+    prop_assert_eq!(again, hinted);
     Ok(())
 }
