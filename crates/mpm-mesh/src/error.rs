@@ -148,6 +148,14 @@ pub enum MeshError {
         /// Nodes per element ($D + 1$ for linear, $(D+1)(D+2)/2$ for quadratic simplices).
         nodes_per_element: usize,
     },
+    /// Moved nodes given for a mesh with another number of nodes.
+    #[error("{found} node positions given for a mesh of {expected} nodes")]
+    NodeCountMismatch {
+        /// The mesh's node count.
+        expected: usize,
+        /// The number of positions given.
+        found: usize,
+    },
     /// More elements than the `u32` element ids of the location buckets can index.
     #[error("{count} elements are more than the {max} a mesh can index")]
     TooManyElements {

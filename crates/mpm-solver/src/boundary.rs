@@ -3,6 +3,8 @@
 
 use nalgebra::SVector;
 
+use crate::mesh::MovableMesh;
+
 /// Prescribed displacement increments of grid degrees of freedom.
 pub trait Constraints<const D: usize>: Send + Sync {
     /// Called at the start of every load step attempt with the material
@@ -14,6 +16,17 @@ pub trait Constraints<const D: usize>: Send + Sync {
     /// mesh node `node` over the load step from load factor `lambda0` to
     /// `lambda1`, or `None` if the degree of freedom is free.
     fn prescribed(&self, node: usize, component: usize, lambda0: f64, lambda1: f64) -> Option<f64>;
+
+    /// Brings the background mesh to its position at load factor `lambda`
+    /// (called at the start of every step attempt with the step's initial
+    /// load factor). Fixed meshes do nothing (the default); see
+    /// [`crate::MovingMesh`].
+    ///
+    /// # Errors
+    /// A message when the mesh cannot take that position.
+    fn move_mesh<M: MovableMesh<D>>(&mut self, _mesh: &mut M, _lambda: f64) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 /// Fixed and prescribed degrees of freedom listed per node: fixed nodes

@@ -146,7 +146,9 @@ impl<const D: usize, H: Flat, Dom: Flat> MaterialPoints<D, H, Dom> {
         out
     }
 
-    /// Points from [`Self::to_flat`]'s numbers.
+    /// Points from [`Self::to_flat`]'s numbers. A
+    /// [`MaterialPoints::body_force_path`] is code, not state: the caller
+    /// sets it again.
     ///
     /// # Errors
     /// [`SolverError::InvalidInput`] when the numbers are truncated, have
@@ -173,6 +175,7 @@ impl<const D: usize, H: Flat, Dom: Flat> MaterialPoints<D, H, Dom> {
             domain: read_all(from, "domain")?,
             body_force: read_all(from, "body_force")?,
             point_force: read_all(from, "point_force")?,
+            body_force_path: None,
         };
         if !from.is_empty() {
             return Err(bad(format!("{} numbers left over", from.len())));

@@ -36,7 +36,7 @@ use crate::error::{SolverError, StepFailure};
 use crate::formulation::Formulation;
 use crate::linear::{Factorisation, LinearSolver};
 use crate::locking::LockingTreatment;
-use crate::mesh::NodalMesh;
+use crate::mesh::{MovableMesh, NodalMesh};
 use crate::points::MaterialPoints;
 use crate::system::{NONE, StepSystem};
 
@@ -196,13 +196,17 @@ where
     linear: Option<LinearSolver>,
     /// The last converged increment per mesh dof and its load increment.
     previous: Option<(Vec<f64>, f64)>,
+    /// Per point, the cell where its location starts (the parent cell of
+    /// the last step; walking on unstructured meshes, Wang et al. 2021
+    /// Algorithm 1); `usize::MAX` when unknown.
+    hints: Vec<usize>,
     _formulation: PhantomData<F>,
 }
 
 impl<const D: usize, B, F, L, K, U, C> ImplicitSolver<D, B, F, L, K, U, C>
 where
     B: BasisFunction<D>,
-    B::Mesh: NodalMesh<D>,
+    B::Mesh: MovableMesh<D>,
     F: Formulation,
     L: LogStrainLaw,
     K: LockingTreatment,
@@ -231,6 +235,7 @@ where
             it: Iterate::default(),
             linear: None,
             previous: None,
+            hints: Vec::new(),
             _formulation: PhantomData,
         }
     }
@@ -244,6 +249,7 @@ where
         lambda0: f64,
         lambda1: f64,
     ) -> Result<StepReport<D>, StepError> {
+        self.move_mesh(lambda0)?;
         self.evaluate_basis(points)?;
         self.constraints.begin_step(&points.position);
         self.build_system(&points.volume, lambda0, lambda1)?;
@@ -317,6 +323,18 @@ where
         })
     }
 
+    /// Stage 0: a moving mesh takes its position at the step's initial load
+    /// factor ([`Constraints::move_mesh`]; nothing for a fixed mesh).
+    pub fn move_mesh(&mut self, lambda0: f64) -> Result<(), SolverError> {
+        self.constraints
+            .move_mesh(&mut self.mesh, lambda0)
+            .map_err(|reason| {
+                SolverError::InvalidInput(format!(
+                    "moving the mesh to load factor {lambda0}: {reason}"
+                ))
+            })
+    }
+
     /// Stage 1: basis values and gradients of every point at the start of
     /// the step, into fixed-stride slots (no allocation per point: each
     /// worker reuses one stencil buffer).
@@ -338,18 +356,20 @@ where
         sys.counts.resize(n, 0);
         let (basis, mesh) = (&self.basis, &self.mesh);
         let node_count = mesh.node_count();
+        self.hints.resize(n, usize::MAX);
         sys.nodes
             .par_chunks_mut(stride)
             .zip(sys.values.par_chunks_mut(stride))
             .zip(sys.grads.par_chunks_mut(stride))
             .zip(sys.counts.par_iter_mut())
+            .zip(self.hints.par_iter_mut())
             .enumerate()
             .try_for_each_init(
                 || Stencil::<D>::with_capacity(stride),
-                |stencil, (p, (((nodes, values), grads), count))| {
+                |stencil, (p, ((((nodes, values), grads), count), hint))| {
                     let x = &points.position[p];
                     basis
-                        .evaluate(mesh, x, &points.domain[p], stencil)
+                        .evaluate_hinted(mesh, x, &points.domain[p], hint, stencil)
                         .map_err(|e| SolverError::Basis {
                             point: p,
                             position: x.iter().copied().collect(),
@@ -498,7 +518,9 @@ where
     }
 
     /// Stage 3: $f^{ext} = \lambda_1\sum_p [S_{vp}]^T(b_p + f_p)$ (eqs. 24,
-    /// 25, 29), constant over the step.
+    /// 25, 29), plus the non-proportional body force
+    /// $\sum_p [S_{vp}]^T b_p(\lambda_1)$ when the points have one; constant
+    /// over the step.
     pub fn assemble_external_force(
         &mut self,
         points: &MaterialPoints<D, L::History, B::Domain>,
@@ -519,6 +541,17 @@ where
         }
         for (p, force) in &points.point_force {
             add(*p, force);
+        }
+        if let Some(path) = &points.body_force_path {
+            for p in 0..points.len() {
+                let force = (path.0)(p, lambda1);
+                for s in sys.slots(p) {
+                    let v = sys.nodes[s] as usize;
+                    for i in 0..D {
+                        f_ext[D * v + i] += sys.values[s] * force[i];
+                    }
+                }
+            }
         }
     }
 
@@ -938,7 +971,7 @@ where
 impl<const D: usize, B, F, L, K, U, C> ImplicitSolver<D, B, F, L, K, U, C>
 where
     B: BasisFunction<D>,
-    B::Mesh: NodalMesh<D>,
+    B::Mesh: MovableMesh<D>,
     F: Formulation,
     L: LogStrainLaw,
     K: LockingTreatment,
@@ -953,6 +986,7 @@ where
         lambda0: f64,
         lambda1: f64,
     ) -> Result<usize, SolverError> {
+        self.move_mesh(lambda0)?;
         self.evaluate_basis(points)?;
         self.constraints.begin_step(&points.position);
         self.build_system(&points.volume, lambda0, lambda1)?;

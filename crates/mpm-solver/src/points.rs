@@ -37,6 +37,22 @@ pub struct MaterialPoints<const D: usize, H, Dom> {
     /// Point loads (point index, force at load factor 1) applied through
     /// eq. (25); empty when the scene has none.
     pub point_force: Vec<(usize, SVector<f64, D>)>,
+    /// A body force that is not proportional to the load factor (e.g. a
+    /// manufactured solution's): the force on point `p` at load factor
+    /// $\lambda$, added to the proportional loads above through eq. (24).
+    pub body_force_path: Option<BodyForcePath<D>>,
+}
+
+/// The force on material point `p` at load factor $\lambda$, `f(p, λ)`.
+#[derive(Clone)]
+pub struct BodyForcePath<const D: usize>(
+    pub std::sync::Arc<dyn Fn(usize, f64) -> SVector<f64, D> + Send + Sync>,
+);
+
+impl<const D: usize> std::fmt::Debug for BodyForcePath<D> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("BodyForcePath(..)")
+    }
 }
 
 impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
@@ -92,6 +108,7 @@ impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
             domain,
             body_force: Vec::new(),
             point_force: Vec::new(),
+            body_force_path: None,
             position,
         })
     }

@@ -12,7 +12,7 @@ use crate::error::SolverError;
 use crate::formulation::Formulation;
 use crate::implicit::{ImplicitSolver, StepError, StepReport};
 use crate::locking::LockingTreatment;
-use crate::mesh::NodalMesh;
+use crate::mesh::MovableMesh;
 use crate::points::MaterialPoints;
 
 /// Load-factor increments: the analysis takes the load factor from 0 to 1.
@@ -88,7 +88,7 @@ pub struct RunSummary {
 impl<const D: usize, B, F, L, K, U, C> ImplicitSolver<D, B, F, L, K, U, C>
 where
     B: BasisFunction<D>,
-    B::Mesh: NodalMesh<D>,
+    B::Mesh: MovableMesh<D>,
     F: Formulation,
     L: LogStrainLaw,
     K: LockingTreatment,

@@ -79,6 +79,42 @@ pub struct SimplexMesh<const D: usize> {
     sets: MeshSets,
 }
 
+/// Per-element geometry of positively oriented elements.
+struct ElementGeometry<const D: usize> {
+    origins: Vec<SVector<f64, D>>,
+    inverse_maps: Vec<SMatrix<f64, D, D>>,
+    gradients: Vec<SVector<f64, D>>,
+    volumes: Vec<f64>,
+}
+
+impl<const D: usize> ElementGeometry<D> {
+    /// First vertex, $\mathbf T^{-1}$ (eq. 13), shape-function gradients and
+    /// volume of every element (the elements must be positively oriented).
+    fn compute(nodes: &[SVector<f64, D>], connectivity: &[usize]) -> Result<Self, MeshError> {
+        let stride = D + 1;
+        let count = connectivity.len() / stride;
+        let mut g = Self {
+            origins: Vec::with_capacity(count),
+            inverse_maps: Vec::with_capacity(count),
+            gradients: Vec::with_capacity(count * stride),
+            volumes: Vec::with_capacity(count),
+        };
+        for (element, vertices) in connectivity.chunks_exact(stride).enumerate() {
+            let volume = signed_volume(nodes, element, vertices)?;
+            let (_, inverse) =
+                geometry::determinant_and_inverse(&geometry::edge_matrix(nodes, vertices));
+            g.origins.push(nodes[vertices[0]]);
+            g.inverse_maps.push(inverse);
+            // N_{k+1} = xi_k: its gradient is row k of T^-1; N_1 = 1 - sum xi.
+            let rows: [SVector<f64, D>; D] = std::array::from_fn(|k| inverse.row(k).transpose());
+            g.gradients.push(-rows.iter().sum::<SVector<f64, D>>());
+            g.gradients.extend_from_slice(&rows);
+            g.volumes.push(volume.abs());
+        }
+        Ok(g)
+    }
+}
+
 impl<const D: usize> SimplexMesh<D> {
     /// A mesh of the nodes `nodes` and the elements `connectivity` (flat,
     /// `D + 1` node ids per element), every element positively oriented
@@ -119,30 +155,17 @@ impl<const D: usize> SimplexMesh<D> {
         let stride = D + 1;
         let count = element_count(connectivity.len(), stride)?;
         check_nodes(&nodes)?;
-        let mut origins = Vec::with_capacity(count);
-        let mut inverse_maps = Vec::with_capacity(count);
-        let mut gradients = Vec::with_capacity(count * stride);
-        let mut volumes = Vec::with_capacity(count);
         for (element, vertices) in connectivity.chunks_exact_mut(stride).enumerate() {
             check_element_nodes(element, vertices, nodes.len())?;
-            let mut volume = signed_volume(&nodes, element, vertices)?;
+            let volume = signed_volume(&nodes, element, vertices)?;
             if volume < 0.0 {
                 if !reorient {
                     return Err(MeshError::InvertedElement { element, volume });
                 }
                 swap_orientation(D, vertices);
-                volume = -volume;
             }
-            let (_, inverse) =
-                geometry::determinant_and_inverse(&geometry::edge_matrix(&nodes, vertices));
-            origins.push(nodes[vertices[0]]);
-            inverse_maps.push(inverse);
-            // N_{k+1} = xi_k: its gradient is row k of T^-1; N_1 = 1 - sum xi.
-            let rows: [SVector<f64, D>; D] = std::array::from_fn(|k| inverse.row(k).transpose());
-            gradients.push(-rows.iter().sum::<SVector<f64, D>>());
-            gradients.extend_from_slice(&rows);
-            volumes.push(volume);
         }
+        let geometry = ElementGeometry::compute(&nodes, &connectivity)?;
         let (neighbours, boundary_faces) = neighbours::neighbour_table::<D>(&connectivity)?;
         let bounding_box = BoundingBox::of_points(&nodes).ok_or(MeshError::NoElements)?;
         let buckets = Buckets::new(
@@ -156,10 +179,10 @@ impl<const D: usize> SimplexMesh<D> {
         let step_budget = 8 * (count as f64).powf(1.0 / D as f64).ceil() as usize + 64;
         Ok(Self {
             connectivity,
-            origins,
-            inverse_maps,
-            gradients,
-            volumes,
+            origins: geometry.origins,
+            inverse_maps: geometry.inverse_maps,
+            gradients: geometry.gradients,
+            volumes: geometry.volumes,
             neighbours,
             boundary_faces,
             bounding_box,
@@ -168,6 +191,48 @@ impl<const D: usize> SimplexMesh<D> {
             sets: MeshSets::new(nodes.len(), count),
             nodes,
         })
+    }
+
+    /// Moves the nodes to `nodes` (same count, same connectivity) and
+    /// recomputes the element geometry, bounding box and location buckets;
+    /// the neighbour table and the named sets are kept. Used by
+    /// moving-mesh boundary conditions (Wang et al. 2021 §2.2).
+    ///
+    /// # Errors
+    /// [`MeshError::NodeCountMismatch`] for a wrong node count,
+    /// [`MeshError::NonFiniteNode`], and [`MeshError::InvertedElement`] or
+    /// [`MeshError::DegenerateElement`] (naming the element) when the
+    /// motion would invert or flatten an element; the mesh is then
+    /// unchanged.
+    pub fn move_nodes(&mut self, nodes: Vec<SVector<f64, D>>) -> Result<(), MeshError> {
+        if nodes.len() != self.nodes.len() {
+            return Err(MeshError::NodeCountMismatch {
+                expected: self.nodes.len(),
+                found: nodes.len(),
+            });
+        }
+        check_nodes(&nodes)?;
+        for (element, vertices) in self.connectivity.chunks_exact(D + 1).enumerate() {
+            let volume = signed_volume(&nodes, element, vertices)?;
+            if volume < 0.0 {
+                return Err(MeshError::InvertedElement { element, volume });
+            }
+        }
+        let geometry = ElementGeometry::compute(&nodes, &self.connectivity)?;
+        let bounding_box = BoundingBox::of_points(&nodes).ok_or(MeshError::NoElements)?;
+        self.buckets = Buckets::new(
+            &nodes,
+            &self.connectivity,
+            bounding_box.lower,
+            bounding_box.upper,
+        );
+        self.origins = geometry.origins;
+        self.inverse_maps = geometry.inverse_maps;
+        self.gradients = geometry.gradients;
+        self.volumes = geometry.volumes;
+        self.bounding_box = bounding_box;
+        self.nodes = nodes;
+        Ok(())
     }
 
     /// Number of nodes.
