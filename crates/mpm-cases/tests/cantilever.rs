@@ -75,8 +75,8 @@ fn cantilever_converges_quadratically_and_ul_equals_pc() {
     // histories agree to 1e-8 relative at every step.
     let mut worst = 0.0f64;
     for (a, b) in pc.tip.iter().zip(&ul.tip) {
-        let diff = ((a.1 - b.1).powi(2) + (a.2 - b.2).powi(2)).sqrt()
-            / (a.1 * a.1 + a.2 * a.2).sqrt();
+        let diff =
+            ((a.1 - b.1).powi(2) + (a.2 - b.2).powi(2)).sqrt() / (a.1 * a.1 + a.2 * a.2).sqrt();
         worst = worst.max(diff);
     }
     println!("UL vs PC: largest relative tip difference {worst:.2e}");
@@ -120,7 +120,15 @@ fn the_pc_solution_satisfies_ul_equilibrium_at_every_step() {
             options,
         );
     let mut ul: ImplicitSolver<2, LinearMpm, UpdatedLagrangian, _, NoLocking, NoUpdate, _> =
-        ImplicitSolver::new(LinearMpm, grid, law, NoLocking, NoUpdate, constraints, options);
+        ImplicitSolver::new(
+            LinearMpm,
+            grid,
+            law,
+            NoLocking,
+            NoUpdate,
+            constraints,
+            options,
+        );
     let mut worst = 0.0f64;
     for step in 0..p.load_steps {
         let (l0, l1) = (
@@ -133,7 +141,10 @@ fn the_pc_solution_satisfies_ul_equilibrium_at_every_step() {
         assert_eq!(ul.prepare_step(&start, l0, l1).unwrap(), du.len());
         ul.free_residual(&start, &du).unwrap();
         let (r_pc, r_ul) = (*report.residuals.last().unwrap(), ul.normalised_residual());
-        assert!(r_ul <= options.tolerance, "step {step}: UL residual {r_ul:e}");
+        assert!(
+            r_ul <= options.tolerance,
+            "step {step}: UL residual {r_ul:e}"
+        );
         worst = worst.max((r_ul - r_pc).abs());
     }
     println!("largest |r_UL - r_PC| at PC's solutions: {worst:.2e}");

@@ -42,7 +42,11 @@ fn an_inverting_motion_or_a_wrong_count_is_refused_and_changes_nothing() {
         .simplex_mesh()
         .unwrap();
     let before = mesh.clone();
-    let mirrored: Vec<_> = mesh.nodes().iter().map(|x| Vector2::new(-x[0], x[1])).collect();
+    let mirrored: Vec<_> = mesh
+        .nodes()
+        .iter()
+        .map(|x| Vector2::new(-x[0], x[1]))
+        .collect();
     assert!(matches!(
         mesh.move_nodes(mirrored),
         Err(MeshError::InvertedElement { .. })

@@ -25,7 +25,10 @@ pub mod system;
 
 pub use boundary::{Constraints, NodalConstraints};
 pub use checkpoint::Flat;
-pub use domain::{DomainContext, DomainError, DomainUpdater, NoUpdate, StretchU};
+pub use domain::{
+    ConvectedCorners, CornerMidpoint, DetF, DiagF, DomainContext, DomainError, DomainUpdater,
+    IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, StretchU, VolumeCorrectedDiagF,
+};
 pub use error::{SolverError, StepFailure};
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
 pub use implicit::{ImplicitSolver, NewtonOptions, StepError, StepReport};

@@ -4,11 +4,24 @@
 
 use nalgebra::{Matrix3, SVector};
 
+mod checks;
+mod convected_corners;
+mod det_f;
+mod diag_f;
+mod incremental_volume_corrected_diag_f;
+mod midpoint;
 mod none;
 mod stretch;
+mod volume_corrected_diag_f;
 
+pub use convected_corners::ConvectedCorners;
+pub use det_f::DetF;
+pub use diag_f::DiagF;
+pub use incremental_volume_corrected_diag_f::IncrementalVolumeCorrectedDiagF;
+pub use midpoint::{CornerMidpoint, Midpoint};
 pub use none::NoUpdate;
 pub use stretch::StretchU;
+pub use volume_corrected_diag_f::VolumeCorrectedDiagF;
 
 /// Why a domain update failed (the solver adds the material point).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
