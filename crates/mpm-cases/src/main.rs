@@ -347,7 +347,7 @@ fn summary<P: Serialize>(
 ) -> Summary<P> {
     Summary {
         case: case.to_string(),
-        variant,
+        variant: variant.resolved(),
         material_points: points,
         load_steps: output.summary.steps,
         cut_steps: output.summary.cut_steps,

@@ -11,6 +11,7 @@ use mpm_solver::{
 use nalgebra::SVector;
 
 use crate::body::{Body, InitialDomain};
+use mpm_basis::Corners;
 
 /// Output quantities of a law's history.
 pub trait HistoryOutput {
@@ -27,6 +28,35 @@ impl HistoryOutput for () {
 impl HistoryOutput for VonMisesHistory {
     fn equivalent_plastic_strain(&self) -> f64 {
         VonMisesHistory::equivalent_plastic_strain(self)
+    }
+}
+
+/// The box a material point's domain covers, for output and for measuring
+/// a body by its domains (Coombs 2020 Table 7).
+pub trait DomainBounds<const D: usize> {
+    /// Lower and upper corners of the domain's bounding box, or `None` for
+    /// bases without a domain.
+    fn bounds(&self, position: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)>;
+}
+
+impl<const D: usize> DomainBounds<D> for () {
+    fn bounds(&self, _: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+        None
+    }
+}
+
+/// GIMP: the box $\mathbf x_p \pm \mathbf l_p$.
+impl<const D: usize> DomainBounds<D> for SVector<f64, D> {
+    fn bounds(&self, position: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+        Some((position - self, position + self))
+    }
+}
+
+/// CPDI2: the bounding box of the corners.
+impl<const D: usize> DomainBounds<D> for Corners<D> {
+    fn bounds(&self, _: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+        let b = self.bounding_box();
+        Some((b.lower, b.upper))
     }
 }
 
@@ -48,6 +78,9 @@ pub struct Snapshot {
     pub volume: Vec<f64>,
     /// Equivalent plastic strain.
     pub plastic_strain: Vec<f64>,
+    /// Lower and upper corners of each point's domain, padded to 3D; empty
+    /// for bases without a domain.
+    pub domain_bounds: Vec<([f64; 3], [f64; 3])>,
     /// Everything needed to resume after this step, when the run was asked
     /// for checkpoints ([`RunControl::checkpoint`]).
     pub checkpoint: Option<Checkpoint>,
@@ -83,7 +116,7 @@ pub struct RunControl {
 
 impl Snapshot {
     /// Copies the state of `points`.
-    pub fn of<const D: usize, H: HistoryOutput, Dom>(
+    pub fn of<const D: usize, H: HistoryOutput, Dom: DomainBounds<D>>(
         points: &MaterialPoints<D, H, Dom>,
         load_factor: f64,
     ) -> Self {
@@ -114,6 +147,12 @@ impl Snapshot {
                 .history
                 .iter()
                 .map(HistoryOutput::equivalent_plastic_strain)
+                .collect(),
+            domain_bounds: points
+                .domain
+                .iter()
+                .zip(&points.position)
+                .filter_map(|(d, x)| d.bounds(x).map(|(lo, hi)| (pad(&lo), pad(&hi))))
                 .collect(),
             checkpoint: None,
         }
@@ -176,7 +215,7 @@ pub fn simulate<const D: usize, B, F, U, L, C, O>(
 ) -> Result<RunOutput<D>, SolverError>
 where
     B: InitialDomain<D, Mesh = RegularGrid<D>>,
-    B::Domain: Flat,
+    B::Domain: Flat + DomainBounds<D>,
     F: Formulation,
     U: DomainUpdater<D, B::Domain>,
     L: LogStrainLaw,

@@ -8,11 +8,14 @@ use std::str::FromStr;
 use mpm_basis::{Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    DomainUpdater, Flat, Formulation, NoUpdate, PreviouslyConverged, StretchU, UpdatedLagrangian,
+    ConvectedCorners, CornerMidpoint, DetF, DiagF, DomainUpdater, Flat, Formulation,
+    IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, PreviouslyConverged, StretchU,
+    UpdatedLagrangian, VolumeCorrectedDiagF,
 };
 use serde::{Deserialize, Serialize};
 
 use crate::body::InitialDomain;
+use crate::run::DomainBounds;
 
 macro_rules! named_enum {
     ($(#[$doc:meta])* $name:ident { $($(#[$vdoc:meta])* $variant:ident => $text:literal),+ $(,)? }) => {
@@ -89,12 +92,17 @@ named_enum!(
         DiagF => "diag_f",
         /// Eq. (34).
         Stretch => "stretch",
-        /// Eqs. (35)–(37).
+        /// Eqs. (35)–(37), corners tracked (Fig. 5a).
         CornerMidpoint => "corner_midpoint",
+        /// Eqs. (36)–(37), mid-points mapped directly (Fig. 5b).
+        Midpoint => "midpoint",
         /// Eq. (38).
         VolumeCorrectedDiagF => "volume_corrected_diag_f",
         /// Eq. (39).
         IncrementalVolumeCorrectedDiagF => "incremental_volume_corrected_diag_f",
+        /// CPDI2: corners convected with the grid (eq. 35 form); the only
+        /// rule for basis = cpdi2, chosen when `none` is given with it.
+        Cpdi2 => "cpdi2",
     }
 );
 
@@ -119,6 +127,20 @@ pub struct Variant {
     pub domain_update: DomainUpdateKind,
 }
 
+impl Variant {
+    /// The variant as it runs: CPDI2 always convects its corners, so
+    /// `domain_update = none` with `basis = cpdi2` reads `cpdi2`.
+    pub fn resolved(self) -> Self {
+        match (self.basis, self.domain_update) {
+            (BasisKind::Cpdi2, DomainUpdateKind::None) => Self {
+                domain_update: DomainUpdateKind::Cpdi2,
+                ..self
+            },
+            _ => self,
+        }
+    }
+}
+
 impl Default for Variant {
     fn default() -> Self {
         Self {
@@ -139,7 +161,7 @@ pub trait VariantVisitor<const D: usize> {
     /// Runs with basis `B`, formulation `F` and domain updater `U`.
     fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
     where
-        B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat>,
+        B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>,
         F: Formulation,
         U: DomainUpdater<D, B::Domain>;
 }
@@ -158,7 +180,7 @@ pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
     ) -> V::Output
     where
         V: VariantVisitor<D>,
-        B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat>,
+        B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>,
         U: DomainUpdater<D, B::Domain>,
     {
         match f {
@@ -186,17 +208,36 @@ pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
             no_domain("bspline2")?;
             Ok(with_formulation(f, visitor, QuadraticBSpline, NoUpdate))
         }
-        BasisKind::Cpdi2 => {
-            no_domain("cpdi2 (its corners are convected)")?;
-            let _ = Cpdi2;
-            Err("basis = cpdi2 needs corner convection in the implicit solver, which arrives with the GIMP/CPDI2 domain-update issue".into())
-        }
-        BasisKind::Gimp => match variant.domain_update {
-            DomainUpdateKind::None => Ok(with_formulation(f, visitor, Gimp, NoUpdate)),
-            DomainUpdateKind::Stretch => Ok(with_formulation(f, visitor, Gimp, StretchU)),
+        BasisKind::Cpdi2 => match variant.domain_update {
+            DomainUpdateKind::None | DomainUpdateKind::Cpdi2 => {
+                Ok(with_formulation(f, visitor, Cpdi2, ConvectedCorners))
+            }
             other => Err(format!(
-                "domain_update = {other} is not implemented yet (it arrives with the GIMP domain-update issue)"
+                "basis = cpdi2 convects its corners with the grid; domain_update = {other} applies to gimp only"
             )),
         },
+        BasisKind::Gimp => {
+            let v = visitor;
+            Ok(match variant.domain_update {
+                DomainUpdateKind::None => with_formulation(f, v, Gimp, NoUpdate),
+                DomainUpdateKind::DetF => with_formulation(f, v, Gimp, DetF),
+                DomainUpdateKind::DiagF => with_formulation(f, v, Gimp, DiagF),
+                DomainUpdateKind::Stretch => with_formulation(f, v, Gimp, StretchU),
+                DomainUpdateKind::CornerMidpoint => with_formulation(f, v, Gimp, CornerMidpoint),
+                DomainUpdateKind::Midpoint => with_formulation(f, v, Gimp, Midpoint),
+                DomainUpdateKind::VolumeCorrectedDiagF => {
+                    with_formulation(f, v, Gimp, VolumeCorrectedDiagF)
+                }
+                DomainUpdateKind::IncrementalVolumeCorrectedDiagF => {
+                    with_formulation(f, v, Gimp, IncrementalVolumeCorrectedDiagF)
+                }
+                DomainUpdateKind::Cpdi2 => {
+                    return Err(
+                        "domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2"
+                            .into(),
+                    );
+                }
+            })
+        }
     }
 }

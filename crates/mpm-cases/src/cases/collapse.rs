@@ -23,7 +23,7 @@ use mpm_solver::{
 use nalgebra::SVector;
 
 use crate::body::{Body, InitialDomain};
-use crate::run::{Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
+use crate::run::{DomainBounds, Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
 crate::case_params! {
@@ -133,7 +133,7 @@ where
 
     fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
     where
-        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat>,
+        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
         F: Formulation,
         U: DomainUpdater<2, B::Domain>,
     {
@@ -160,14 +160,22 @@ where
         };
         let output =
             simulate::<2, B, F, U, _, _, _>(setup, basis, updater, self.control, self.observer)?;
+        // The edge of the body: of the domains where the basis has them
+        // (GIMP, CPDI2), else of the points' initial half-spacing l0.
+        let last = &output.last;
         let edge = |axis: usize| {
-            output
-                .last
-                .position
-                .iter()
-                .zip(&body.half_lengths)
-                .map(|(x, l)| x[axis] + l[axis])
-                .fold(f64::NEG_INFINITY, f64::max)
+            if last.domain_bounds.is_empty() {
+                last.position
+                    .iter()
+                    .zip(&body.half_lengths)
+                    .map(|(x, l)| x[axis] + l[axis])
+                    .fold(f64::NEG_INFINITY, f64::max)
+            } else {
+                last.domain_bounds
+                    .iter()
+                    .map(|(_, hi)| hi[axis])
+                    .fold(f64::NEG_INFINITY, f64::max)
+            }
         };
         let (horizontal_extent, max_height) = (edge(0), edge(1));
         Ok(CollapseResult {

@@ -16,7 +16,7 @@ use mpm_solver::{
 use nalgebra::SVector;
 
 use crate::body::{Body, InitialDomain};
-use crate::run::{Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
+use crate::run::{DomainBounds, Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
 crate::case_params! {
@@ -131,7 +131,7 @@ where
 
     fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
     where
-        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat>,
+        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
         F: Formulation,
         U: DomainUpdater<2, B::Domain>,
     {

@@ -48,7 +48,8 @@ use nalgebra::{Matrix2, Matrix3, SVector};
 
 use crate::body::{Body, InitialDomain};
 use crate::run::{
-    Checkpoint, HistoryOutput, Loads, RunControl, RunOutput, Setup, Snapshot, simulate,
+    Checkpoint, DomainBounds, HistoryOutput, Loads, RunControl, RunOutput, Setup, Snapshot,
+    simulate,
 };
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
@@ -247,7 +248,7 @@ where
 {
     fn go<B, F, U, L>(self, basis: B, updater: U, law: L) -> Result<ShearResult, SolverError>
     where
-        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat>,
+        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
         F: Formulation,
         U: DomainUpdater<2, B::Domain>,
         L: LogStrainLaw + Clone,
@@ -350,7 +351,7 @@ where
 
     fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
     where
-        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat>,
+        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
         F: Formulation,
         U: DomainUpdater<2, B::Domain>,
     {
