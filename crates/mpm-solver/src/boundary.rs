@@ -7,10 +7,10 @@ use crate::mesh::MovableMesh;
 
 /// Prescribed displacement increments of grid degrees of freedom.
 pub trait Constraints<const D: usize>: Send + Sync {
-    /// Called at the start of every load step attempt with the material
-    /// point positions, for conditions that follow the body (e.g. the
-    /// cells holding its boundary points). The default does nothing.
-    fn begin_step(&mut self, _positions: &[SVector<f64, D>]) {}
+    /// Called at the start of every load step attempt, after the basis
+    /// has been evaluated, for conditions that follow the body (e.g. every
+    /// node supporting a boundary point). The default does nothing.
+    fn begin_step(&mut self, _step: &StepView<'_, D>) {}
 
     /// The prescribed displacement increment of component `component` of
     /// mesh node `node` over the load step from load factor `lambda0` to
@@ -26,6 +26,46 @@ pub trait Constraints<const D: usize>: Send + Sync {
     /// A message when the mesh cannot take that position.
     fn move_mesh<M: MovableMesh<D>>(&mut self, _mesh: &mut M, _lambda: f64) -> Result<(), String> {
         Ok(())
+    }
+}
+
+/// What [`Constraints::begin_step`] may read: the material point positions
+/// and the mesh nodes of every point's stencil at the start of the step.
+#[derive(Debug, Clone, Copy)]
+pub struct StepView<'a, const D: usize> {
+    positions: &'a [SVector<f64, D>],
+    nodes: &'a [u32],
+    counts: &'a [u32],
+    stride: usize,
+}
+
+impl<'a, const D: usize> StepView<'a, D> {
+    /// A view of `positions` and the stencils stored `stride` slots per
+    /// point in `nodes` (mesh node ids), `counts[p]` of them used.
+    pub fn new(
+        positions: &'a [SVector<f64, D>],
+        nodes: &'a [u32],
+        counts: &'a [u32],
+        stride: usize,
+    ) -> Self {
+        Self {
+            positions,
+            nodes,
+            counts,
+            stride,
+        }
+    }
+
+    /// Material point positions at the start of the step.
+    pub fn positions(&self) -> &'a [SVector<f64, D>] {
+        self.positions
+    }
+
+    /// Mesh nodes supporting point `p` (its basis stencil).
+    pub fn nodes_of(&self, p: usize) -> impl Iterator<Item = usize> + 'a {
+        let start = p * self.stride;
+        let count = self.counts.get(p).copied().unwrap_or(0) as usize;
+        self.nodes[start..start + count].iter().map(|&v| v as usize)
     }
 }
 

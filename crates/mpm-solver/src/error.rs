@@ -35,6 +35,22 @@ pub enum StepFailure {
         /// The constitutive error.
         source: ConstitutiveError,
     },
+    /// A Newton iterate stretched or compressed a material point beyond the
+    /// admissible increment ([`crate::NewtonOptions::max_increment_norm`]):
+    /// the load step is too large, or the iterates are sliding along a
+    /// near-mechanism (a point alone with nodes no other point supports)
+    /// into the region where the Hencky stress softens.
+    #[error(
+        "material point {point}: |ΔF| = {norm:.3e} or |ΔF⁻¹| beyond the admissible {limit} in one load step"
+    )]
+    ExcessiveIncrement {
+        /// Index of the material point.
+        point: usize,
+        /// The larger of $\|\Delta F\|_F$ and $\|\Delta F^{-1}\|_F$.
+        norm: f64,
+        /// The limit.
+        limit: f64,
+    },
     /// The linear solver failed (singular or non-finite system).
     #[error("linear solve failed: {reason}")]
     LinearSolve {

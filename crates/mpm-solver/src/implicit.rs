@@ -30,7 +30,7 @@ use mpm_constitutive::{ConsistentTangent, LogStrainLaw, MaterialState, Response,
 use nalgebra::{Matrix3, SMatrix, SVector};
 use rayon::prelude::*;
 
-use crate::boundary::Constraints;
+use crate::boundary::{Constraints, StepView};
 use crate::domain::{DomainContext, DomainError, DomainUpdater};
 use crate::error::{SolverError, StepFailure};
 use crate::formulation::Formulation;
@@ -62,6 +62,16 @@ pub struct NewtonOptions {
     /// receive would move the points through $S_{vp}\Delta u_v$ (eq. 31).
     /// Zero disables the rule.
     pub weak_node_threshold: f64,
+    /// Nodes whose stiffness weight $\sum_p |\nabla S_{vp}|^2 V^n_p$ is below
+    /// this fraction of the largest are held fixed over the step too. For
+    /// domain-based bases (GIMP, CPDI2, B-splines) value and gradient of a
+    /// fringe node vanish together, so holding it adds a reaction of the
+    /// order of $\sigma\,\nabla S_{vp}V_p$, which is small; left free, two
+    /// such nodes touched by one point only form a mechanism (a rotation
+    /// that strains no point) along which Newton iterates run away.
+    /// Standard MPM's far-side nodes keep gradients of order $1/h$ and are
+    /// not affected. Zero disables the rule.
+    pub weak_node_stiffness: f64,
     /// Start each step's iterations from the previous step's converged
     /// increment, scaled by the ratio of load increments, at the free
     /// nodes that were active then (a secant predictor). Off, the free
@@ -70,6 +80,15 @@ pub struct NewtonOptions {
     /// the branch of the previous step where the equilibrium path has
     /// bifurcations (perfect plasticity).
     pub predictor: bool,
+    /// Largest admissible $\max(\|\Delta F\|_F, \|\Delta F^{-1}\|_F)$ of
+    /// any material point within one load step (the identity has
+    /// $\sqrt3$; 10 allows principal stretches from about 0.1 to 9.9). An
+    /// iterate beyond it fails the step, which is retried with a smaller
+    /// increment: Newton iterates that slide along a near-mechanism grow a
+    /// point's stretch geometrically while the Hencky stress
+    /// $\propto \ln\lambda/\lambda$ and hence the residual decay, and would
+    /// otherwise "converge" with the point flung far away.
+    pub max_increment_norm: f64,
 }
 
 impl Default for NewtonOptions {
@@ -79,7 +98,9 @@ impl Default for NewtonOptions {
             max_iterations: 30,
             divergence_factor: 1e6,
             weak_node_threshold: 1e-6,
+            weak_node_stiffness: 1e-4,
             predictor: false,
+            max_increment_norm: 10.0,
         }
     }
 }
@@ -251,7 +272,13 @@ where
     ) -> Result<StepReport<D>, StepError> {
         self.move_mesh(lambda0)?;
         self.evaluate_basis(points)?;
-        self.constraints.begin_step(&points.position);
+        let sys = &self.system;
+        self.constraints.begin_step(&StepView::new(
+            &points.position,
+            &sys.nodes,
+            &sys.counts,
+            sys.stride,
+        ));
         self.build_system(&points.volume, lambda0, lambda1)?;
         self.predict(lambda1 - lambda0);
         self.assemble_external_force(points, lambda1);
@@ -409,18 +436,32 @@ where
         sys.number_nodes(node_count);
         sys.build_adjacency();
         sys.build_neighbours();
-        let support: Vec<f64> = (0..sys.n_active())
+        // Per active node: support Σ S V and stiffness weight Σ |∇S|² V.
+        let (support, stiffness): (Vec<f64>, Vec<f64>) = (0..sys.n_active())
             .map(|v| {
-                sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]]
-                    .iter()
-                    .map(|&(p, a)| {
-                        sys.values[p as usize * sys.stride + a as usize] * volumes[p as usize]
-                    })
-                    .sum()
+                sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]].iter().fold(
+                    (0.0, 0.0),
+                    |(s, k), &(p, a)| {
+                        let slot = p as usize * sys.stride + a as usize;
+                        let volume = volumes[p as usize];
+                        (
+                            s + sys.values[slot] * volume,
+                            k + sys.grads[slot].norm_squared() * volume,
+                        )
+                    },
+                )
             })
+            .unzip();
+        let max = |x: &[f64]| x.iter().copied().fold(0.0, f64::max);
+        let (support_cut, stiffness_cut) = (
+            self.options.weak_node_threshold * max(&support),
+            self.options.weak_node_stiffness * max(&stiffness),
+        );
+        let weak: Vec<bool> = support
+            .iter()
+            .zip(&stiffness)
+            .map(|(&s, &k)| s < support_cut || k < stiffness_cut)
             .collect();
-        let cutoff = self.options.weak_node_threshold * support.iter().copied().fold(0.0, f64::max);
-        let weak: Vec<bool> = support.iter().map(|&w| w < cutoff).collect();
         let constraints = &self.constraints;
         let active_of_mesh = std::mem::take(&mut sys.active_of_mesh);
         sys.build_pattern(|node, i| {
@@ -556,7 +597,8 @@ where
     }
 
     /// Stage 4a with backtracking: when a Newton correction inverts a
-    /// material point (det ΔF <= 0 or another constitutive failure), the
+    /// material point (det ΔF <= 0 or another constitutive failure) or
+    /// stretches it beyond [`NewtonOptions::max_increment_norm`], the
     /// correction is halved, up to [`MAX_BACKTRACKS`] times, before the step
     /// is declared failed. Sparsely populated cells give nodes with little
     /// stiffness whose corrections can overshoot; backtracking keeps Newton
@@ -568,7 +610,9 @@ where
     ) -> Result<bool, StepFailure> {
         let mut result = self.update_material_points(points);
         let mut backtracks = 0;
-        while let Err(StepFailure::Constitutive { .. }) = result {
+        while let Err(StepFailure::Constitutive { .. } | StepFailure::ExcessiveIncrement { .. }) =
+            result
+        {
             if !after_solve || backtracks == MAX_BACKTRACKS {
                 break;
             }
@@ -626,6 +670,7 @@ where
             self.locking.prepare(&it.increments, &it.volumes);
         }
         let (law, locking) = (&self.law, &self.locking);
+        let limit = self.options.max_increment_norm;
         let stride = sys.stride;
         let mapped_chunks = it.mapped.par_chunks_mut(stride.max(1));
         let failure = it
@@ -641,6 +686,14 @@ where
                 };
                 match update(law, &delta_f, &points.f[p], &state) {
                     Ok(r) => {
+                        let norm = r.delta_f.norm().max(r.delta_f_inv.norm());
+                        if norm > limit {
+                            return Some(StepFailure::ExcessiveIncrement {
+                                point: p,
+                                norm,
+                                limit,
+                            });
+                        }
                         *stress = F::stress(&r) * F::volume(&r, points.volume[p]);
                         *response = Some(r);
                         None
@@ -650,17 +703,12 @@ where
             })
             .reduce(
                 || None,
-                |a, b| match (&a, &b) {
-                    (
-                        Some(StepFailure::Constitutive { point: pa, .. }),
-                        Some(StepFailure::Constitutive { point: pb, .. }),
-                    ) => {
-                        if pa <= pb {
-                            a
-                        } else {
-                            b
-                        }
-                    }
+                // The failure of the lowest point, whatever the thread count.
+                |a, b| match (
+                    a.as_ref().and_then(failed_point),
+                    b.as_ref().and_then(failed_point),
+                ) {
+                    (Some(pa), Some(pb)) if pb < pa => b,
                     (Some(_), _) => a,
                     _ => b,
                 },
@@ -939,6 +987,16 @@ where
     }
 }
 
+/// The material point a failure names, if any.
+fn failed_point(f: &StepFailure) -> Option<usize> {
+    match f {
+        StepFailure::Constitutive { point, .. } | StepFailure::ExcessiveIncrement { point, .. } => {
+            Some(*point)
+        }
+        _ => None,
+    }
+}
+
 /// Runs `f(w, values_of_block_w)` for the block columns `lo..hi` in
 /// parallel, splitting `vals` (which starts at block `lo`, value index
 /// `base`) into disjoint slices at block boundaries.
@@ -988,7 +1046,13 @@ where
     ) -> Result<usize, SolverError> {
         self.move_mesh(lambda0)?;
         self.evaluate_basis(points)?;
-        self.constraints.begin_step(&points.position);
+        let sys = &self.system;
+        self.constraints.begin_step(&StepView::new(
+            &points.position,
+            &sys.nodes,
+            &sys.counts,
+            sys.stride,
+        ));
         self.build_system(&points.volume, lambda0, lambda1)?;
         self.assemble_external_force(points, lambda1);
         Ok(self.system.n_free)

@@ -23,7 +23,7 @@ pub mod points;
 pub mod stepping;
 pub mod system;
 
-pub use boundary::{Constraints, NodalConstraints};
+pub use boundary::{Constraints, NodalConstraints, StepView};
 pub use checkpoint::Flat;
 pub use domain::{
     ConvectedCorners, CornerMidpoint, DetF, DiagF, DomainContext, DomainError, DomainUpdater,

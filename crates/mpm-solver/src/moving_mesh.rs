@@ -15,7 +15,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::boundary::Constraints;
+use crate::boundary::{Constraints, StepView};
 use crate::mesh::MovableMesh;
 
 /// Node positions as a function of the load factor.
@@ -220,8 +220,8 @@ impl<const D: usize, C, M: MeshMotion<D>> MovingMesh<D, C, M> {
 }
 
 impl<const D: usize, C: Constraints<D>, M: MeshMotion<D>> Constraints<D> for MovingMesh<D, C, M> {
-    fn begin_step(&mut self, positions: &[SVector<f64, D>]) {
-        self.inner.begin_step(positions);
+    fn begin_step(&mut self, step: &StepView<'_, D>) {
+        self.inner.begin_step(step);
     }
 
     fn prescribed(&self, node: usize, component: usize, lambda0: f64, lambda1: f64) -> Option<f64> {

@@ -22,11 +22,12 @@
 //! exact ties without changing the problem.
 //!
 //! The shearing is imposed, as in the paper, on every node that supports a
-//! boundary point — for standard MPM exactly the nodes of the cells that
-//! hold the body's boundary points; for wider bases (B-spline, GIMP) every
-//! node within their support radius, so that each free node's support lies
-//! inside the body: $\Delta u_x = \Delta\gamma\,Y_v$, $\Delta u_y = 0$ at
-//! node height $Y_v$; the nodes inside are free.
+//! boundary point (its basis stencil at the start of the step: for standard
+//! MPM the nodes of the cells holding the body's boundary points, for GIMP,
+//! CPDI2 and B-splines every node their domain or support reaches), so that
+//! each free node's support lies inside the body:
+//! $\Delta u_x = \Delta\gamma\,Y_v$, $\Delta u_y = 0$ at node height $Y_v$;
+//! the nodes inside are free.
 //!
 //! Reference: the deformation is homogeneous, so every point must carry
 //! the stress of a single material point driven through the same
@@ -42,7 +43,7 @@ use mpm_constitutive::{
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
     Constraints, DomainUpdater, Flat, Formulation, LoadStepping, NewtonOptions, SolverError,
-    StepReport,
+    StepReport, StepView,
 };
 use nalgebra::{Matrix2, Matrix3, SVector};
 
@@ -82,35 +83,22 @@ crate::case_params! {
     }
 }
 
-/// Prescribed shear on the nodes of the cells holding the boundary points.
+/// Prescribed shear on every node supporting a boundary point.
 #[derive(Debug, Clone)]
 struct BoundaryCellShear {
     grid: RegularGrid<2>,
-    radius: f64,
     boundary_points: Vec<usize>,
     prescribed: Vec<bool>,
     shear: f64,
 }
 
 impl Constraints<2> for BoundaryCellShear {
-    fn begin_step(&mut self, positions: &[SVector<f64, 2>]) {
+    fn begin_step(&mut self, step: &StepView<'_, 2>) {
         self.prescribed.iter_mut().for_each(|p| *p = false);
-        let h = *self.grid.spacing();
-        let [nx, ny] = self.grid.nodes_per_axis();
-        let origin = *self.grid.origin();
         for &p in &self.boundary_points {
-            let t = (positions[p] - origin).component_div(&h);
-            let range = |t: f64, n: usize| {
-                let lo = (t - self.radius).floor().max(0.0) as usize;
-                let hi = ((t + self.radius).ceil().max(0.0) as usize).min(n - 1);
-                lo..=hi
-            };
-            for j in range(t[1], ny) {
-                for i in range(t[0], nx) {
-                    let d = ((i as f64 - t[0]).abs(), (j as f64 - t[1]).abs());
-                    if d.0 < self.radius && d.1 < self.radius {
-                        self.prescribed[j * nx + i] = true;
-                    }
+            for v in step.nodes_of(p) {
+                if let Some(flag) = self.prescribed.get_mut(v) {
+                    *flag = true;
                 }
             }
         }
@@ -277,7 +265,6 @@ where
             .collect();
         let constraints = BoundaryCellShear {
             prescribed: vec![false; grid.node_count()],
-            radius: B::SUPPORT_RADIUS,
             grid: grid.clone(),
             boundary_points,
             shear: p.shear,
