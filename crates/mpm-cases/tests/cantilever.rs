@@ -150,3 +150,33 @@ fn the_pc_solution_satisfies_ul_equilibrium_at_every_step() {
     println!("largest |r_UL - r_PC| at PC's solutions: {worst:.2e}");
     assert!(worst <= 1e-12, "{worst:e}");
 }
+
+/// The elastica reproduces Euler–Bernoulli theory for small loads (tip
+/// deflection α/3, axial shortening α²/15 from inextensibility) and keeps
+/// the tip on the arc of the beam's length.
+#[test]
+fn the_elastica_reference_has_the_small_load_limits() {
+    use mpm_cases::cases::cantilever::elastica_tip;
+    let alpha = 1e-3;
+    let (u, v) = elastica_tip(alpha);
+    assert!((v + alpha / 3.0).abs() < 1e-6 * alpha, "{v}");
+    assert!(
+        (u + alpha * alpha / 15.0).abs() < 1e-3 * alpha * alpha,
+        "{u}"
+    );
+    // Bisshopp & Drucker (1945), also Gere & Timoshenko: at PL²/EI = 1 the
+    // tip deflects by 0.30172 l0 and moves in by 0.05643 l0.
+    let (u, v) = elastica_tip(1.0);
+    assert!(
+        (v + 0.30172).abs() < 1e-5 && (u + 0.05643).abs() < 1e-5,
+        "{u} {v}"
+    );
+    let mut previous = 0.0;
+    for alpha in [0.5, 2.0, 5.0, 10.0, 20.0] {
+        let (u, v) = elastica_tip(alpha);
+        // The tip lies inside the circle of radius l0 about the root and
+        // deflects monotonically with the load.
+        assert!((1.0 + u).hypot(v) < 1.0 && v < previous, "{alpha}: {u} {v}");
+        previous = v;
+    }
+}

@@ -215,3 +215,54 @@ where
     )
     .map_err(SolverError::InvalidInput)?
 }
+
+/// The large-deflection (elastica) solution of an inextensible cantilever
+/// under a vertical end load that keeps its direction: the normalised tip
+/// displacements $(u/l_0, v/l_0)$ (horizontal, vertical; both negative for
+/// a downward load) for the load parameter $\alpha = P l_0^2/(EI)$.
+///
+/// With $\theta(s)$ the rotation of the centre line at arc length $s$,
+/// moment equilibrium of the part beyond $s$ gives
+/// $EI\,\theta'(s) = P\,(x(L) - x(s))$, hence
+/// $\theta'' = -\alpha\cos\theta$ (in $s/l_0$) with $\theta(0) = 0$ at the
+/// clamped root and $\theta'(1) = 0$ at the free tip. The curvature at the
+/// root $\kappa_0 = \theta'(0) \in (0, \alpha]$ is found by bisection on
+/// $\theta'(1)$ (the map is monotone), integrating $\theta$, $x$, $y$ with
+/// classical Runge–Kutta on 4000 steps; then
+/// $u = x(1) - 1$ and $v = -\int_0^1\sin\theta\,ds$. This is the classical
+/// solution (Bisshopp & Drucker 1945; the "analytical solution" of Coombs
+/// et al. 2020 Figs. 13, 15, 17).
+pub fn elastica_tip(alpha: f64) -> (f64, f64) {
+    if alpha.abs() < f64::MIN_POSITIVE {
+        return (0.0, 0.0);
+    }
+    const STEPS: usize = 4000;
+    // State (theta, kappa, x, y) along s in [0, 1].
+    let integrate = |kappa0: f64| -> [f64; 4] {
+        let rhs = |z: [f64; 4]| [z[1], -alpha * z[0].cos(), z[0].cos(), z[0].sin()];
+        let ds = 1.0 / STEPS as f64;
+        let mut z = [0.0, kappa0, 0.0, 0.0];
+        let axpy = |z: [f64; 4], k: [f64; 4], a: f64| std::array::from_fn(|i| z[i] + a * k[i]);
+        for _ in 0..STEPS {
+            let k1 = rhs(z);
+            let k2 = rhs(axpy(z, k1, ds / 2.0));
+            let k3 = rhs(axpy(z, k2, ds / 2.0));
+            let k4 = rhs(axpy(z, k3, ds));
+            z = std::array::from_fn(|i| {
+                z[i] + ds / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
+        }
+        z
+    };
+    let (mut lo, mut hi) = (0.0, alpha);
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if integrate(mid)[1] > 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let z = integrate(0.5 * (lo + hi));
+    (z[2] - 1.0, -z[3])
+}

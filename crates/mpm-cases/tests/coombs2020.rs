@@ -1,0 +1,254 @@
+//! Reproduction of Coombs et al. (2020) §7 with GIMP and CPDI2: Fig. 7
+//! (column convergence per domain-update rule), Table 7 (collapse extent
+//! and height per rule), Table 8 (Newton residuals of the GIMP collapse)
+//! and the cantilever of §7.3 with GIMP (eq. 37) and CPDI2 against the
+//! elastica. Reference values are the paper's, quoted where they are used.
+//! `cargo run --release -p xtask -- reproduce coombs2020` writes the same
+//! studies as tables and plots into `docs/src/reproduction/`.
+#![allow(clippy::unwrap_used)]
+
+use mpm_cases::cases::cantilever::{self, CantileverParams, elastica_tip};
+use mpm_cases::cases::collapse::{self, CollapseParams};
+use mpm_cases::cases::column::{self, ColumnParams};
+use mpm_cases::run::RunControl;
+use mpm_cases::variant::{BasisKind, DomainUpdateKind, FormulationKind, Variant};
+
+fn variant(basis: BasisKind, domain_update: DomainUpdateKind) -> Variant {
+    Variant {
+        basis,
+        domain_update,
+        ..Variant::default()
+    }
+}
+
+fn gimp(rule: DomainUpdateKind) -> Variant {
+    variant(BasisKind::Gimp, rule)
+}
+
+fn cpdi2() -> Variant {
+    variant(BasisKind::Cpdi2, DomainUpdateKind::Cpdi2)
+}
+
+/// Column error (eq. 42) with 2×2 points per cell for h = 50/2^k.
+fn column_errors(v: &Variant, ks: std::ops::RangeInclusive<i32>) -> Vec<f64> {
+    ks.map(|k| {
+        let p = ColumnParams {
+            h: 50.0 / 2f64.powi(k),
+            ..ColumnParams::default()
+        };
+        column::run(&p, v, &RunControl::default(), |_, _, _| Ok(()))
+            .unwrap()
+            .error
+    })
+    .collect()
+}
+
+/// Fig. 7: "When the domains are not updated or when the domains are updated
+/// according to the determinant of the deformation gradient (32), the
+/// method fails to converge beyond the third and sixth analyses,
+/// respectively. However, when the domains are updated according to (33),
+/// (34) or (37) the method continues to converge with background grid
+/// refinement at the same rate as the CPDI2 method." The paper's range is
+/// k = 2..7; k = 8, 9 are added so that the stall is unmistakable.
+#[test]
+fn fig7_domain_rules_that_track_the_compaction_keep_converging() {
+    use DomainUpdateKind as R;
+    let converging = [
+        gimp(R::DiagF),
+        gimp(R::Stretch),
+        gimp(R::CornerMidpoint),
+        gimp(R::Midpoint),
+        gimp(R::VolumeCorrectedDiagF),
+        gimp(R::IncrementalVolumeCorrectedDiagF),
+        cpdi2(),
+    ];
+    let stalling = [gimp(R::None), gimp(R::DetF)];
+    let mut best_fine = f64::INFINITY;
+    for v in &converging {
+        let e = column_errors(v, 2..=9);
+        println!("{:>36}: {}", v.domain_update.name(), fmt(&e));
+        // Monotone, and still an order of magnitude down from k = 7 to 9
+        // (measured: 0.10 for every rule).
+        assert!(e.windows(2).all(|w| w[1] < w[0]), "{e:?}");
+        assert!(e[7] <= 0.15 * e[5], "{e:?}");
+        best_fine = best_fine.min(e[7]);
+    }
+    for v in &stalling {
+        let e = column_errors(v, 2..=9);
+        println!("{:>36}: {}", v.domain_update.name(), fmt(&e));
+        // Flat or rising from k = 7 to 9 (measured: 1.10 without update,
+        // 0.90 with det F) and an order of magnitude above the tracking
+        // rules at k = 9. Measured onset: both stall from k = 7 (the
+        // paper: no update from k = 4).
+        assert!(e[7] >= 0.8 * e[5], "{e:?}");
+        assert!(e[7] >= 10.0 * best_fine, "{e:?}");
+    }
+}
+
+fn fmt(e: &[f64]) -> String {
+    e.iter()
+        .map(|x| format!("{x:.3e}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Table 7: "collapse extent and height with the generalised interpolation
+/// and CPDI2 methods with h = 1 m and 6² material points", measured at the
+/// edges of the domains.
+#[test]
+fn table7_collapse_extent_and_height_per_domain_rule() {
+    use DomainUpdateKind as R;
+    let p = CollapseParams {
+        points_per_cell: 6,
+        ..CollapseParams::default()
+    };
+    let run = |v: &Variant| {
+        let r = collapse::run(&p, v, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+        assert_eq!(r.output.reports.len(), 40, "{v:?}: no step cut");
+        println!(
+            "{:>36}: extent {:.4} height {:.4}",
+            v.domain_update.name(),
+            r.horizontal_extent,
+            r.max_height
+        );
+        (r.horizontal_extent, r.max_height)
+    };
+    let within = |(x, y): (f64, f64), (px, py): (f64, f64), tol: f64| {
+        assert!(
+            ((x - px) / px).abs() <= tol && ((y - py) / py).abs() <= tol,
+            "({x}, {y}) vs ({px}, {py})"
+        );
+    };
+    // Reproduced within 1 % (measured: 0.02 % or better).
+    let det_f = run(&gimp(R::DetF));
+    within(det_f, (13.645, 6.316), 0.01);
+    let eq38 = run(&gimp(R::VolumeCorrectedDiagF));
+    within(eq38, (13.769, 6.257), 0.01);
+    within(
+        run(&gimp(R::IncrementalVolumeCorrectedDiagF)),
+        (13.769, 6.257),
+        0.01,
+    );
+    within(run(&cpdi2()), (13.780, 6.292), 0.01);
+    // Eq. (37): the extent is the paper's (13.769); the height is that of
+    // eqs. (38)/(39) and CPDI2, 2.1 % below the paper's 6.392.
+    let eq37 = run(&gimp(R::CornerMidpoint));
+    assert!(((eq37.0 - 13.769) / 13.769).abs() <= 0.01);
+    within(eq37, eq38, 0.002);
+    // Eqs. (33) and (34): the paper reports a softer (14.415, 5.546) and a
+    // stiffer (13.425, 6.441) collapse. Implemented as written (total F_ii
+    // and U_ii; also tried incrementally), both give the collapse of the
+    // volume-corrected rules within 0.3 %: the rotations reach 59° only in
+    // a few points at the toe (min |F_ii| = 0.42), whose domains shrink
+    // without changing the global response. See
+    // docs/src/reproduction/coombs2020.md.
+    within(run(&gimp(R::DiagF)), eq38, 0.003);
+    within(run(&gimp(R::Stretch)), eq38, 0.003);
+}
+
+/// Table 8: GIMP collapse (h = 1 m, 6² points) residuals of steps 10, 20,
+/// 30, 40 — "once approaching the correct solution asymptotic quadratic
+/// convergence is achieved" in 3, 5, 6 and 6 iterations.
+#[test]
+fn table8_gimp_collapse_converges_quadratically() {
+    let p = CollapseParams {
+        points_per_cell: 6,
+        ..CollapseParams::default()
+    };
+    let r = collapse::run(
+        &p,
+        &gimp(DomainUpdateKind::CornerMidpoint),
+        &RunControl::default(),
+        |_, _, _| Ok(()),
+    )
+    .unwrap();
+    let paper_iterations = [3, 5, 6, 6];
+    for (step, paper) in [9, 19, 29, 39].into_iter().zip(paper_iterations) {
+        let res = &r.output.reports[step].residuals;
+        println!("step {}: {}", step + 1, fmt(res));
+        assert!(*res.last().unwrap() <= 1e-9);
+        assert!(res.len() - 1 <= paper + 1, "{res:?}");
+        let w = res
+            .windows(2)
+            .rfind(|w| w[0] < 1e-2 && w[1] > 1e-12)
+            .unwrap();
+        assert!(w[1] <= 100.0 * w[0] * w[0], "{res:?}");
+    }
+}
+
+/// Largest distance of the tip history from the elastica (α = P l0²/EI at
+/// each load factor), in units of l0: (horizontal, vertical).
+fn elastica_deviation(p: &CantileverParams, tip: &[(f64, f64, f64)]) -> (f64, f64) {
+    let ei = p.youngs_modulus * p.depth.powi(3) / 12.0;
+    tip.iter()
+        .fold((0.0f64, 0.0f64), |(du, dv), &(lambda, u, v)| {
+            let (ua, va) = elastica_tip(lambda * p.load * p.length.powi(2) / ei);
+            (
+                du.max((u / p.length - ua).abs()),
+                dv.max((v / p.length - va).abs()),
+            )
+        })
+}
+
+/// §7.3 with GIMP (eq. 37, 6² points, Fig. 15) and CPDI2 (4² points; the
+/// paper's Fig. 17 uses 3², but the load is split between the two points
+/// beside the neutral axis, which needs an even count): all 50 steps
+/// converge, UL = PC, and the tip at full load is within 0.015 l0 of the
+/// elastica (α = P l0²/EI = 10). Along the path, h = 0.5 m (two cells
+/// through the depth) is too stiff in early bending and the point load
+/// makes it overshoot late (the paper's Fig. 16); refining to h = 0.25 m
+/// brings the whole GIMP history closer to the elastica.
+#[test]
+fn cantilever_with_gimp_and_cpdi2_follows_the_elastica() {
+    let mut coarse = 0.0;
+    for (v, ppc) in [(gimp(DomainUpdateKind::CornerMidpoint), 6), (cpdi2(), 4)] {
+        let p = CantileverParams {
+            points_per_cell: ppc,
+            ..CantileverParams::default()
+        };
+        let go = |f: FormulationKind| {
+            let v = Variant {
+                formulation: f,
+                ..v
+            };
+            cantilever::run(&p, &v, &RunControl::default(), |_, _, _| Ok(())).unwrap()
+        };
+        let (pc, ul) = (go(FormulationKind::Pc), go(FormulationKind::Ul));
+        assert_eq!(pc.output.reports.len(), 50, "{v:?}");
+        let worst_ul = pc
+            .tip
+            .iter()
+            .zip(&ul.tip)
+            .map(|(a, b)| (a.1 - b.1).hypot(a.2 - b.2) / a.1.hypot(a.2))
+            .fold(0.0, f64::max);
+        let last = *pc.tip.last().unwrap();
+        let (u, w) = elastica_tip(10.0);
+        let end = ((last.1 / p.length - u).abs(), (last.2 / p.length - w).abs());
+        let path = elastica_deviation(&p, &pc.tip);
+        println!(
+            "{} {ppc}x{ppc}, h = {}: tip at full load off the elastica by {end:.4?} l0, along the path by up to {path:.4?}; UL vs PC {worst_ul:.1e}",
+            v.basis.name(),
+            p.h
+        );
+        assert!(end.0 <= 0.015 && end.1 <= 0.015, "{end:?}");
+        assert!(worst_ul <= 1e-8);
+        if v.basis == BasisKind::Gimp {
+            coarse = path.0.max(path.1);
+        }
+    }
+    let p = CantileverParams {
+        h: 0.25,
+        points_per_cell: 6,
+        ..CantileverParams::default()
+    };
+    let fine = cantilever::run(
+        &p,
+        &gimp(DomainUpdateKind::CornerMidpoint),
+        &RunControl::default(),
+        |_, _, _| Ok(()),
+    )
+    .unwrap();
+    let path = elastica_deviation(&p, &fine.tip);
+    println!("gimp 6x6, h = 0.25: along the path off by up to {path:.4?} (h = 0.5: {coarse:.4})");
+    assert!(path.0.max(path.1) <= 0.75 * coarse, "{path:?} vs {coarse}");
+}
