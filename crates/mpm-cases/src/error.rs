@@ -20,6 +20,12 @@ pub enum CasesError {
         /// The operating system's error.
         source: std::io::Error,
     },
+    /// The background mesh could not be updated for output.
+    #[error("background mesh: {reason}")]
+    Mesh {
+        /// What went wrong.
+        reason: String,
+    },
     /// A checkpoint file that cannot be resumed from.
     #[error("{}: not a usable checkpoint: {reason}", path.display())]
     Checkpoint {

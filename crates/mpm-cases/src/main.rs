@@ -15,11 +15,11 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use mpm_cases::cases::{cantilever, collapse, column, shear};
 use mpm_cases::checkpoint;
+use mpm_cases::output::CellMesh;
 use mpm_cases::run::{RunControl, Snapshot};
 use mpm_cases::scene_file::parse_scene;
 use mpm_cases::variant::{BasisKind, Variant};
 use mpm_cases::writer::{RunWriter, Summary};
-use mpm_mesh::RegularGrid;
 use mpm_solver::{SolverError, StepReport};
 use serde::Serialize;
 use serde_json::{Map, Value, json};
@@ -199,7 +199,11 @@ impl Run {
     /// checkpoints always; with `--resume`, the checkpoint of the output
     /// directory, which must have been written by the same case and
     /// parameters.
-    fn start<P: Serialize>(&self, p: &P, grid: RegularGrid<2>) -> Result<(Observer, RunControl)> {
+    fn start<const D: usize, M: CellMesh<D>, P: Serialize>(
+        &self,
+        p: &P,
+        grid: M,
+    ) -> Result<(Observer<D, M>, RunControl)> {
         let parameters = serde_json::to_value(p)?;
         let (writer, resume) = if self.resume {
             let (header, checkpoint) = checkpoint::read(&self.out)?;
@@ -228,8 +232,8 @@ impl Run {
 }
 
 /// Progress display and file output, called after every converged step.
-struct Observer {
-    writer: RunWriter,
+struct Observer<const D: usize, M> {
+    writer: RunWriter<D, M>,
     bar: ProgressBar,
     plain: bool,
     case: String,
@@ -238,8 +242,8 @@ struct Observer {
     steps: usize,
 }
 
-impl Observer {
-    fn new(writer: RunWriter, case: String, parameters: Value) -> Result<Self> {
+impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
+    fn new(writer: RunWriter<D, M>, case: String, parameters: Value) -> Result<Self> {
         let plain = !std::io::stderr().is_terminal();
         let bar = if plain {
             ProgressBar::hidden()
@@ -269,7 +273,7 @@ impl Observer {
     fn step(
         &mut self,
         step: usize,
-        report: &StepReport<2>,
+        report: &StepReport<D>,
         snap: &Snapshot,
     ) -> Result<(), SolverError> {
         let residual = report.residuals.last().copied().unwrap_or(0.0);
@@ -336,11 +340,11 @@ impl Observer {
     }
 }
 
-fn summary<P: Serialize>(
+fn summary<const D: usize, P: Serialize>(
     case: &str,
     variant: Variant,
     points: usize,
-    output: &mpm_cases::run::RunOutput<2>,
+    output: &mpm_cases::run::RunOutput<D>,
     error: Option<f64>,
     results: Map<String, Value>,
     parameters: P,

@@ -3,10 +3,10 @@
 use std::time::Instant;
 
 use mpm_constitutive::{LogStrainLaw, VonMisesHistory};
-use mpm_mesh::RegularGrid;
 use mpm_solver::{
     Constraints, DomainUpdater, Flat, Formulation, ImplicitSolver, LoadStepping, MaterialPoints,
-    NewtonOptions, NoLocking, RunState, RunSummary, SolverError, StepReport,
+    MovableMesh, NewtonOptions, NoLocking, NodalMesh, RunState, RunSummary, SolverError,
+    StepReport,
 };
 use nalgebra::SVector;
 
@@ -81,6 +81,9 @@ pub struct Snapshot {
     /// Lower and upper corners of each point's domain, padded to 3D; empty
     /// for bases without a domain.
     pub domain_bounds: Vec<([f64; 3], [f64; 3])>,
+    /// The background mesh's node positions, padded to 3D, when the mesh
+    /// moves (moving-mesh boundary conditions); `None` for a fixed mesh.
+    pub mesh_nodes: Option<Vec<[f64; 3]>>,
     /// Everything needed to resume after this step, when the run was asked
     /// for checkpoints ([`RunControl::checkpoint`]).
     pub checkpoint: Option<Checkpoint>,
@@ -154,6 +157,7 @@ impl Snapshot {
                 .zip(&points.position)
                 .filter_map(|(d, x)| d.bounds(x).map(|(lo, hi)| (pad(&lo), pad(&hi))))
                 .collect(),
+            mesh_nodes: None,
             checkpoint: None,
         }
     }
@@ -182,11 +186,11 @@ pub struct RunOutput<const D: usize> {
     pub wall_time_s: f64,
 }
 
-/// A body, a grid, a law, loads and constraints: one quasi-static analysis.
+/// A body, a mesh, a law, loads and constraints: one quasi-static analysis.
 #[derive(Debug, Clone)]
-pub struct Setup<'a, const D: usize, L, C> {
-    /// The background grid.
-    pub grid: RegularGrid<D>,
+pub struct Setup<'a, const D: usize, M, L, C> {
+    /// The background mesh.
+    pub grid: M,
     /// The material points' layout.
     pub body: &'a Body<D>,
     /// Density.
@@ -207,14 +211,15 @@ pub struct Setup<'a, const D: usize, L, C> {
 /// sees each converged step's report and state (its time is excluded from
 /// `wall_time_s`). `control` asks for checkpoints or resumes from one.
 pub fn simulate<const D: usize, B, F, U, L, C, O>(
-    setup: Setup<'_, D, L, C>,
+    setup: Setup<'_, D, B::Mesh, L, C>,
     basis: B,
     updater: U,
     control: &RunControl,
     mut observer: O,
 ) -> Result<RunOutput<D>, SolverError>
 where
-    B: InitialDomain<D, Mesh = RegularGrid<D>>,
+    B: InitialDomain<D>,
+    B::Mesh: MovableMesh<D>,
     B::Domain: Flat + DomainBounds<D>,
     F: Formulation,
     U: DomainUpdater<D, B::Domain>,
@@ -276,6 +281,16 @@ where
             let t = Instant::now();
             reports.push(report.clone());
             let mut snapshot = Snapshot::of(pts, report.lambda1);
+            if C::MOVES_MESH {
+                snapshot.mesh_nodes = Some(
+                    (0..now.mesh.node_count())
+                        .map(|v| {
+                            let x = now.mesh.node_position(v);
+                            std::array::from_fn(|i| if i < D { x[i] } else { 0.0 })
+                        })
+                        .collect(),
+                );
+            }
             if control.checkpoint {
                 snapshot.checkpoint = Some(Checkpoint {
                     state: now.state,

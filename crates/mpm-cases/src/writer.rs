@@ -6,22 +6,22 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use mpm_mesh::RegularGrid;
 use mpm_solver::StepReport;
 use serde::Serialize;
 
 use crate::CasesError;
 use crate::output::{
-    CellType, CsvTable, CsvValue, PvdSeries, PvdStep, UnstructuredGrid, Values, write_summary,
+    CellMesh, CsvTable, CsvValue, PvdSeries, PvdStep, UnstructuredGrid, Values, write_summary,
 };
 use crate::run::Snapshot;
 use crate::variant::Variant;
 
-/// Output of one run in a directory.
+/// Output of one run in a directory, for material points in `D`
+/// dimensions on the background mesh `M`.
 #[derive(Debug)]
-pub struct RunWriter {
+pub struct RunWriter<const D: usize, M> {
     dir: PathBuf,
-    grid: RegularGrid<2>,
+    grid: M,
     points: PvdSeries,
     cells: PvdSeries,
     steps: CsvTable,
@@ -72,9 +72,17 @@ pub struct Summary<P: Serialize> {
     pub parameters: P,
 }
 
-impl RunWriter {
+/// Columns of `steps.csv`: reactions per component of the dimension.
+fn step_columns(dim: usize) -> Vec<&'static str> {
+    let mut columns = vec!["step", "load_factor", "iterations"];
+    columns.extend(["reaction_x", "reaction_y", "reaction_z"].iter().take(dim));
+    columns.extend(["active_nodes", "free_dofs"]);
+    columns
+}
+
+impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
     /// Creates `dir` (and parents) and the empty series.
-    pub fn new(dir: &Path, grid: RegularGrid<2>) -> Result<Self, CasesError> {
+    pub fn new(dir: &Path, grid: M) -> Result<Self, CasesError> {
         std::fs::create_dir_all(dir).map_err(|source| CasesError::Io {
             path: dir.to_path_buf(),
             source,
@@ -84,15 +92,7 @@ impl RunWriter {
             grid,
             points: PvdSeries::new(dir.join("points.pvd")),
             cells: PvdSeries::new(dir.join("grid.pvd")),
-            steps: CsvTable::new(&[
-                "step",
-                "load_factor",
-                "iterations",
-                "reaction_x",
-                "reaction_y",
-                "active_nodes",
-                "free_dofs",
-            ])?,
+            steps: CsvTable::new(&step_columns(D))?,
             iterations: CsvTable::new(&["step", "iteration", "normalised_residual"])?,
             tables: BTreeMap::new(),
         })
@@ -100,12 +100,8 @@ impl RunWriter {
 
     /// A writer that continues the series and tables of `state` (a resumed
     /// run); files of later steps are overwritten as the run proceeds.
-    pub fn resume(
-        dir: &Path,
-        grid: RegularGrid<2>,
-        state: WriterState,
-    ) -> Result<Self, CasesError> {
-        if state.steps.header() != Self::new(dir, grid.clone())?.steps.header() {
+    pub fn resume(dir: &Path, grid: M, state: WriterState) -> Result<Self, CasesError> {
+        if state.steps.header() != step_columns(D) {
             return Err(CasesError::Checkpoint {
                 path: dir.to_path_buf(),
                 reason: "its steps table has other columns than this version writes".into(),
@@ -159,9 +155,14 @@ impl RunWriter {
     pub fn step(
         &mut self,
         step: usize,
-        report: &StepReport<2>,
+        report: &StepReport<D>,
         snap: &Snapshot,
     ) -> Result<(), CasesError> {
+        if let Some(nodes) = &snap.mesh_nodes {
+            self.grid
+                .set_nodes(nodes)
+                .map_err(|reason| CasesError::Mesh { reason })?;
+        }
         let name = format!("points_{step:04}.vtu");
         let path = self.dir.join(&name);
         let mut vtu = UnstructuredGrid::new(&snap.position)?;
@@ -174,6 +175,12 @@ impl RunWriter {
             "equivalent_plastic_strain",
             Values::scalars(&snap.plastic_strain),
         )?;
+        let (lower, upper): (Vec<[f64; 3]>, Vec<[f64; 3]>) =
+            snap.domain_bounds.iter().copied().unzip();
+        if !lower.is_empty() {
+            vtu.point_data("domain_lower", Values::vectors(&lower))?;
+            vtu.point_data("domain_upper", Values::vectors(&upper))?;
+        }
         vtu.write(&path)?;
         self.points.push(report.lambda1, &path)?;
 
@@ -181,15 +188,17 @@ impl RunWriter {
         self.write_active_grid(&grid_path, snap)?;
         self.cells.push(report.lambda1, &grid_path)?;
 
-        self.steps.push_row(&[
+        let mut row = vec![
             CsvValue::from(step),
             CsvValue::from(report.lambda1),
             CsvValue::from(report.iterations()),
-            CsvValue::from(report.reaction[0]),
-            CsvValue::from(report.reaction[1]),
+        ];
+        row.extend(report.reaction.iter().map(|r| CsvValue::from(*r)));
+        row.extend([
             CsvValue::from(report.active_nodes),
             CsvValue::from(report.free_dofs),
-        ])?;
+        ]);
+        self.steps.push_row(&row)?;
         self.steps.write(&self.dir.join("steps.csv"))?;
         for (k, r) in report.residuals.iter().enumerate() {
             self.iterations.push_row(&[
@@ -201,39 +210,12 @@ impl RunWriter {
         self.iterations.write(&self.dir.join("iterations.csv"))
     }
 
-    /// The grid cells holding material points, as VTK quads.
+    /// The mesh cells holding material points.
     fn write_active_grid(&self, path: &Path, snap: &Snapshot) -> Result<(), CasesError> {
-        let positions: Vec<nalgebra::SVector<f64, 2>> = snap
-            .position
-            .iter()
-            .map(|x| nalgebra::SVector::<f64, 2>::new(x[0], x[1]))
-            .collect();
-        let nodes: Vec<[f64; 3]> = (0..self.grid.node_count())
-            .map(|n| {
-                let x = self.grid.node_position(n).unwrap_or_default();
-                [x[0], x[1], 0.0]
-            })
-            .collect();
-        let mut connectivity = Vec::new();
-        let [nx, _] = self.grid.nodes_per_axis();
-        for (i, j) in positions
-            .iter()
-            .filter_map(|x| self.grid.cell_containing(x).ok())
-            .map(|c| (c[0], c[1]))
-        {
-            let base = j * nx + i;
-            connectivity.extend_from_slice(&[base, base + 1, base + 1 + nx, base + nx]);
-        }
-        // One quad per cell (several points share a cell).
-        let mut quads: Vec<[usize; 4]> = connectivity
-            .chunks(4)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect();
-        quads.sort_unstable();
-        quads.dedup();
-        let flat: Vec<usize> = quads.iter().flatten().copied().collect();
+        let nodes = self.grid.vtk_nodes();
+        let cells = self.grid.cells_holding(&snap.position);
         let mut vtu = UnstructuredGrid::new(&nodes)?;
-        vtu.add_cells(CellType::Quad, &flat)?;
+        vtu.add_cells(M::CELL, &cells)?;
         vtu.write(path)
     }
 

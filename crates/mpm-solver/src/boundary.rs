@@ -7,6 +7,10 @@ use crate::mesh::MovableMesh;
 
 /// Prescribed displacement increments of grid degrees of freedom.
 pub trait Constraints<const D: usize>: Send + Sync {
+    /// Whether [`Constraints::move_mesh`] moves the mesh (outputs then
+    /// record its node positions every step).
+    const MOVES_MESH: bool = false;
+
     /// Called at the start of every load step attempt, after the basis
     /// has been evaluated, for conditions that follow the body (e.g. every
     /// node supporting a boundary point). The default does nothing.

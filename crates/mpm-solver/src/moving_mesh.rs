@@ -220,6 +220,8 @@ impl<const D: usize, C, M: MeshMotion<D>> MovingMesh<D, C, M> {
 }
 
 impl<const D: usize, C: Constraints<D>, M: MeshMotion<D>> Constraints<D> for MovingMesh<D, C, M> {
+    const MOVES_MESH: bool = true;
+
     fn begin_step(&mut self, step: &StepView<'_, D>) {
         self.inner.begin_step(step);
     }

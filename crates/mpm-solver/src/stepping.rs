@@ -67,11 +67,14 @@ impl RunState {
 /// What the observer of [`ImplicitSolver::run_from`] learns besides the
 /// step report and the points: the state to resume from.
 #[derive(Debug, Clone, Copy)]
-pub struct StepContext<'a> {
+pub struct StepContext<'a, M> {
     /// Load stepping state after the step.
     pub state: RunState,
     /// [`ImplicitSolver::predictor_state`] after the step.
     pub predictor: Option<(&'a [f64], f64)>,
+    /// The background mesh the step was solved on (it moves with
+    /// moving-mesh conditions).
+    pub mesh: &'a M,
 }
 
 /// What a whole analysis did.
@@ -131,7 +134,7 @@ where
             usize,
             &StepReport<D>,
             &MaterialPoints<D, L::History, B::Domain>,
-            &StepContext<'_>,
+            &StepContext<'_, B::Mesh>,
         ) -> Result<(), SolverError>,
     {
         if !(stepping.min > 0.0
@@ -170,6 +173,7 @@ where
                     let context = StepContext {
                         state: now,
                         predictor: self.predictor_state(),
+                        mesh: &self.mesh,
                     };
                     observer(summary.steps - 1, &report, points, &context)?;
                 }

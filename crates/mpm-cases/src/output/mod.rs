@@ -9,6 +9,7 @@
 mod atomic;
 pub mod csv;
 mod finite;
+pub mod mesh_cells;
 pub mod pvd;
 pub mod summary;
 mod text;
@@ -16,6 +17,7 @@ pub mod vtk;
 
 pub use atomic::{atomic_write, atomic_write_with};
 pub use csv::{CsvTable, CsvValue};
+pub use mesh_cells::CellMesh;
 pub use pvd::{PvdSeries, PvdStep};
 pub use summary::{summary_json, write_summary};
 pub use vtk::{CellType, UnstructuredGrid, Values};
