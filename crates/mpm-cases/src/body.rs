@@ -1,7 +1,7 @@
 //! Material point bodies filling rectangular (box) regions of a grid.
 
-use mpm_basis::{BasisFunction, Corners, Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
-use mpm_mesh::RegularGrid;
+use mpm_basis::{BasisFunction, Corners, Cpdi2, Gimp, LinearMpm, LinearSimplex, QuadraticBSpline};
+use mpm_mesh::{RegularGrid, SimplexMesh};
 use nalgebra::SVector;
 
 /// Material points laid out `points_per_cell` per direction in every cell
@@ -65,6 +65,37 @@ impl<const D: usize> Body<D> {
         body
     }
 
+    /// Material points in the elements `elements` of a simplex mesh,
+    /// `rule` per element ([`SimplexRule`]), each with its share of the
+    /// element's volume; the points have no domain (zero half-lengths)
+    /// and no lattice.
+    pub fn fill_simplices(mesh: &SimplexMesh<D>, elements: &[usize], rule: SimplexRule) -> Self {
+        let local = rule.points::<D>();
+        let mut body = Self {
+            position: Vec::with_capacity(elements.len() * local.len()),
+            volume: Vec::with_capacity(elements.len() * local.len()),
+            half_lengths: Vec::new(),
+            lattice: Vec::new(),
+            lattice_size: [0; D],
+        };
+        for &e in elements {
+            let nodes = mesh.element_nodes(e);
+            let volume = mesh.volumes()[e];
+            for (bary, share) in &local {
+                let x = nodes
+                    .iter()
+                    .zip(bary)
+                    .fold(SVector::<f64, D>::zeros(), |x, (&v, &w)| {
+                        x + mesh.nodes()[v] * w
+                    });
+                body.position.push(x);
+                body.volume.push(volume * share);
+            }
+        }
+        body.half_lengths = vec![SVector::zeros(); body.position.len()];
+        body
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         self.position.len()
@@ -73,6 +104,107 @@ impl<const D: usize> Body<D> {
     /// Whether the body is empty.
     pub fn is_empty(&self) -> bool {
         self.position.is_empty()
+    }
+}
+
+/// Where material points sit in a simplex, as barycentric coordinates with
+/// a share of the element's volume.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SimplexRule {
+    /// The element split into $n^D$ sub-simplices of equal volume (in 2D
+    /// the similar sub-triangles of $n$ divisions per edge; in 3D the
+    /// $n^3$ tetrahedra of the Freudenthal split of the $n$-divided
+    /// element), one point at each centroid.
+    Subdivision(usize),
+    /// The 11 points of Keast's degree-4 tetrahedral rule (Keast 1986,
+    /// as used by Wang et al. 2021 §5) with equal volumes $V/11$ (the
+    /// rule's own weights include a negative one, which cannot be a
+    /// volume). 3D only; in 2D it falls back to `Subdivision(3)`.
+    Keast11,
+}
+
+impl SimplexRule {
+    /// Barycentric coordinates (D+1 entries used) and volume shares.
+    pub fn points<const D: usize>(self) -> Vec<([f64; 4], f64)> {
+        match (self, D) {
+            (SimplexRule::Keast11, 3) => {
+                let mut out = vec![([0.25; 4], 1.0 / 11.0)];
+                let (a, b) = (1.0 / 14.0, 11.0 / 14.0);
+                for k in 0..4 {
+                    let mut w = [a; 4];
+                    w[k] = b;
+                    out.push((w, 1.0 / 11.0));
+                }
+                let (c, d) = (0.399_403_576_166_799_2, 0.100_596_423_833_200_8);
+                for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+                    let mut w = [d; 4];
+                    w[i] = c;
+                    w[j] = c;
+                    out.push((w, 1.0 / 11.0));
+                }
+                out
+            }
+            (SimplexRule::Keast11, _) => SimplexRule::Subdivision(3).points::<D>(),
+            (SimplexRule::Subdivision(n), _) => subdivision_centroids::<D>(n.max(1)),
+        }
+    }
+}
+
+/// Centroids of the $n^D$ equal-volume sub-simplices of a simplex
+/// (Freudenthal's subdivision), in barycentric coordinates. The simplex is
+/// taken as the Kuhn simplex $K = \{1 \ge y_1 \ge \dots \ge y_D \ge 0\}$
+/// (affinely equivalent to any simplex, with vertices
+/// $\mathbf v_k = \sum_{i \le k}\mathbf e_i$); the cubes of the
+/// $1/n$-lattice split into $D!$ Kuhn simplices, of which those inside $K$
+/// (tested at their centroid: $K$'s facets are faces of that
+/// triangulation) are exactly $n^D$ translates and reflections of $K/n$.
+fn subdivision_centroids<const D: usize>(n: usize) -> Vec<([f64; 4], f64)> {
+    let share = 1.0 / (n as f64).powi(D as i32);
+    let mut permutation: Vec<usize> = (0..D).collect();
+    let mut permutations = Vec::new();
+    permutations_of(&mut permutation, 0, &mut permutations);
+    let mut out = Vec::new();
+    for flat in 0..n.pow(D as u32) {
+        let mut base = [0usize; 3];
+        let mut rest = flat;
+        for b in base.iter_mut().take(D) {
+            *b = rest % n;
+            rest /= n;
+        }
+        for perm in &permutations {
+            let mut vertex = base;
+            let mut y = [0.0f64; 3];
+            for step in 0..=D {
+                if step > 0 {
+                    vertex[perm[step - 1]] += 1;
+                }
+                for i in 0..D {
+                    y[i] += vertex[i] as f64 / ((D + 1) * n) as f64;
+                }
+            }
+            if (1..D).all(|i| y[i - 1] > y[i]) {
+                let mut w = [0.0; 4];
+                w[0] = 1.0 - y[0];
+                for k in 1..D {
+                    w[k] = y[k - 1] - y[k];
+                }
+                w[D] = y[D - 1];
+                out.push((w, share));
+            }
+        }
+    }
+    out
+}
+
+fn permutations_of(p: &mut Vec<usize>, k: usize, out: &mut Vec<Vec<usize>>) {
+    if k == p.len() {
+        out.push(p.clone());
+        return;
+    }
+    for i in k..p.len() {
+        p.swap(k, i);
+        permutations_of(p, k + 1, out);
+        p.swap(k, i);
     }
 }
 
@@ -89,6 +221,10 @@ pub trait InitialDomain<const D: usize>: BasisFunction<D> {
 
     /// The undeformed domain.
     fn initial_domain(position: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> Self::Domain;
+}
+
+impl<const D: usize> InitialDomain<D> for LinearSimplex {
+    fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
 }
 
 impl<const D: usize> InitialDomain<D> for LinearMpm {
@@ -113,5 +249,55 @@ impl<const D: usize> InitialDomain<D> for Cpdi2 {
     const SUPPORT_RADIUS: f64 = 1.5;
     fn initial_domain(position: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> Corners<D> {
         Corners::rectangle(position, half_lengths)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check<const D: usize>(rule: SimplexRule, count: usize) {
+        let points = rule.points::<D>();
+        assert_eq!(points.len(), count, "{rule:?} in {D}D");
+        let total: f64 = points.iter().map(|p| p.1).sum();
+        assert!((total - 1.0).abs() < 1e-14);
+        for k in 0..=D {
+            // Equal shares at the sub-centroids integrate the barycentric
+            // coordinates exactly: the mean is the element centroid.
+            let mean: f64 = points.iter().map(|(w, s)| w[k] * s).sum();
+            assert!(
+                (mean - 1.0 / (D + 1) as f64).abs() < 1e-14,
+                "{rule:?} {k}: {mean}"
+            );
+        }
+        for (w, _) in &points {
+            assert!(w.iter().take(D + 1).all(|&x| x > 0.0));
+            assert!((w.iter().take(D + 1).sum::<f64>() - 1.0).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn simplex_rules_place_points_inside_with_volumes_summing_to_one() {
+        for n in 1..=4 {
+            check::<2>(SimplexRule::Subdivision(n), n * n);
+            check::<3>(SimplexRule::Subdivision(n), n * n * n);
+        }
+        check::<3>(SimplexRule::Keast11, 11);
+        // Two divisions of a triangle: the three corner sub-triangles and
+        // the middle one.
+        let mut two: Vec<[f64; 3]> = SimplexRule::Subdivision(2)
+            .points::<2>()
+            .iter()
+            .map(|(w, _)| [w[0], w[1], w[2]])
+            .collect();
+        two.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
+        let (a, b) = (4.0 / 6.0, 1.0 / 6.0);
+        let expected = [[b, b, a], [b, a, b], [1.0 / 3.0; 3], [a, b, b]];
+        for (got, want) in two.iter().zip(expected) {
+            assert!(
+                got.iter().zip(want).all(|(x, y)| (x - y).abs() < 1e-14),
+                "{two:?}"
+            );
+        }
     }
 }

@@ -13,7 +13,7 @@ use std::time::Duration;
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use mpm_cases::cases::{cantilever, collapse, column, shear};
+use mpm_cases::cases::{annulus, cantilever, collapse, column, shear};
 use mpm_cases::checkpoint;
 use mpm_cases::output::CellMesh;
 use mpm_cases::run::{RunControl, Snapshot};
@@ -65,7 +65,7 @@ enum Command {
     },
 }
 
-const CASES: [(&str, &str); 4] = [
+const CASES: [(&str, &str); 5] = [
     (
         "column",
         "Coombs 2020 §7.1: elastic column compacting under self weight (analytic eq. 41, error eq. 42)",
@@ -77,6 +77,10 @@ const CASES: [(&str, &str); 4] = [
     (
         "cantilever",
         "Coombs 2020 §7.3: elastic cantilever under an end load (tip history, Newton residuals)",
+    ),
+    (
+        "annulus",
+        "Coombs 2020 §7.4: elastic annulus under torsion on triangles (manufactured solution, Fig. 19)",
     ),
     (
         "collapse",
@@ -100,6 +104,7 @@ fn run_cli(cli: Cli) -> Result<()> {
                     "column" => toml::to_string(&column::ColumnParams::default()),
                     "shear" => toml::to_string(&shear::ShearParams::default()),
                     "cantilever" => toml::to_string(&cantilever::CantileverParams::default()),
+                    "annulus" => toml::to_string(&annulus::AnnulusParams::default()),
                     _ => toml::to_string(&collapse::CollapseParams::default()),
                 }?;
                 for line in defaults.lines() {
@@ -155,12 +160,18 @@ fn run_cli(cli: Cli) -> Result<()> {
                 out,
                 resume,
                 stop_after,
+                scene_dir: scene
+                    .as_deref()
+                    .and_then(|p| p.parent())
+                    .map(PathBuf::from)
+                    .unwrap_or_default(),
             };
             let result = match name.as_str() {
                 "column" => column_run(&parse_scene(&text, &origin, &set)?, &run),
                 "shear" => shear_run(&parse_scene(&text, &origin, &set)?, &run),
                 "cantilever" => cantilever_run(&parse_scene(&text, &origin, &set)?, &run),
                 "collapse" => collapse_run(&parse_scene(&text, &origin, &set)?, &run),
+                "annulus" => annulus_run(parse_scene(&text, &origin, &set)?, &run),
                 other => bail!(
                     "unknown case `{other}`; cases: {}",
                     CASES.iter().map(|c| c.0).collect::<Vec<_>>().join(", ")
@@ -192,9 +203,20 @@ struct Run {
     out: PathBuf,
     resume: bool,
     stop_after: Option<usize>,
+    /// Directory of the scene file: relative mesh paths start there.
+    scene_dir: PathBuf,
 }
 
 impl Run {
+    /// `path` taken from the scene file's directory when relative.
+    fn resolve(&self, path: &mut Option<PathBuf>) {
+        if let Some(p) = path
+            && p.is_relative()
+        {
+            *p = self.scene_dir.join(&*p);
+        }
+    }
+
     /// The observer and the run control for a case with parameters `p`:
     /// checkpoints always; with `--resume`, the checkpoint of the output
     /// directory, which must have been written by the same case and
@@ -451,6 +473,29 @@ fn collapse_run(p: &collapse::CollapseParams, run: &Run) -> Result<()> {
         None,
         results,
         p,
+    );
+    obs.finish(s)
+}
+
+fn annulus_run(mut p: annulus::AnnulusParams, run: &Run) -> Result<()> {
+    run.resolve(&mut p.mesh);
+    let mesh = annulus::mesh(&p)?;
+    let (mut obs, control) = run.start(&p, mesh)?;
+    let r = annulus::run(&p, &p.variant(), &control, |s, rep, snap| {
+        obs.step(s, rep, snap)
+    })?;
+    let mut results = Map::new();
+    results.insert("max_error".into(), json!(r.max_error));
+    results.insert("elements".into(), json!(r.elements));
+    results.insert("element_size".into(), json!(r.element_size));
+    let s = summary(
+        "annulus",
+        p.variant(),
+        r.material_points,
+        &r.output,
+        Some(r.error),
+        results,
+        &p,
     );
     obs.finish(s)
 }

@@ -4,9 +4,9 @@ use std::time::Instant;
 
 use mpm_constitutive::{LogStrainLaw, VonMisesHistory};
 use mpm_solver::{
-    Constraints, DomainUpdater, Flat, Formulation, ImplicitSolver, LoadStepping, MaterialPoints,
-    MovableMesh, NewtonOptions, NoLocking, NodalMesh, RunState, RunSummary, SolverError,
-    StepReport,
+    BodyForcePath, Constraints, DomainUpdater, Flat, Formulation, ImplicitSolver, LoadStepping,
+    MaterialPoints, MovableMesh, NewtonOptions, NoLocking, NodalMesh, RunState, RunSummary,
+    SolverError, StepReport,
 };
 use nalgebra::SVector;
 
@@ -170,6 +170,8 @@ pub struct Loads<const D: usize> {
     pub gravity: Option<SVector<f64, D>>,
     /// Point loads (point index, force at load factor 1).
     pub point_forces: Vec<(usize, SVector<f64, D>)>,
+    /// A body force that is not proportional to the load factor.
+    pub body_force_path: Option<BodyForcePath<D>>,
 }
 
 /// Everything a run produced.
@@ -245,6 +247,7 @@ where
         points.set_gravity(g);
     }
     points.point_force = setup.loads.point_forces.clone();
+    points.body_force_path = setup.loads.body_force_path.clone();
     let mut solver: ImplicitSolver<D, B, F, L, NoLocking, U, C> = ImplicitSolver::new(
         basis,
         setup.grid,
@@ -264,7 +267,10 @@ where
                     points.len()
                 )));
             }
-            points = resumed;
+            points = MaterialPoints {
+                body_force_path: points.body_force_path.take(),
+                ..resumed
+            };
             solver.set_predictor_state(c.predictor.clone())?;
             (c.state, c.wall_time_s)
         }

@@ -43,7 +43,7 @@ fn no_nan_in(dir: &Path) {
 fn list_names_every_case() {
     let (ok, out, _) = mpm(&["list"]);
     assert!(ok);
-    for case in ["column", "shear", "cantilever", "collapse"] {
+    for case in ["column", "shear", "cantilever", "annulus", "collapse"] {
         assert!(out.contains(&format!("{case}:")), "{out}");
     }
 }
@@ -336,4 +336,45 @@ fn resume_refuses_another_scene_a_missing_or_a_damaged_checkpoint() {
     ]);
     assert!(!ok && err.contains("not a usable checkpoint"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
+}
+
+/// A Gmsh mesh read through a scene file (its path relative to the scene),
+/// written as triangles beside the points.
+#[test]
+fn a_gmsh_scene_runs_on_its_triangles() {
+    let dir = temp_dir("gmsh-scene");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/annulus_gmsh.toml");
+    let (ok, out, err) = mpm(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--set",
+        "points_per_element=2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("annulus [linear pc none none]: 2472 points"),
+        "{out}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["elements"], 618);
+    assert!(summary["error"].as_f64().unwrap() < 1e-2);
+    let grid = std::fs::read_to_string(dir.join("grid_0009.vtu")).unwrap();
+    // VTK_TRIANGLE = 5 for every active cell.
+    let types = grid.split("Name=\"types\"").nth(1).unwrap();
+    let types = &types[types.find('>').unwrap() + 1..types.find("</DataArray>").unwrap()];
+    assert!(!types.trim().is_empty() && types.split_whitespace().all(|t| t == "5"));
+    no_nan_in(&dir);
+    // A missing mesh file is a clear error naming it.
+    let (ok, _, err) = mpm(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--set",
+        "mesh=meshes/none.msh",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("none.msh"), "{err}");
 }

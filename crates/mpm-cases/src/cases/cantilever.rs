@@ -166,6 +166,7 @@ where
             loads: Loads {
                 gravity: None,
                 point_forces: vec![(loaded[0], force), (loaded[1], force)],
+                body_force_path: None,
             },
             constraints,
             stepping: LoadStepping::uniform(p.load_steps),

@@ -147,6 +147,7 @@ where
             loads: Loads {
                 gravity: Some(SVector::<f64, 2>::new(0.0, -p.gravity)),
                 point_forces: Vec::new(),
+                body_force_path: None,
             },
             constraints,
             stepping: LoadStepping::uniform(p.load_steps),

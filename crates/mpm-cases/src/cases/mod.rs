@@ -1,5 +1,6 @@
 //! The benchmark cases, each with its reference solution.
 
+pub mod annulus;
 pub mod cantilever;
 pub mod collapse;
 pub mod column;

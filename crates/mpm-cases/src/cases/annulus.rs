@@ -1,0 +1,319 @@
+//! Elastic annulus under torsion (Coombs et al. 2020 §7.4, Figs. 18–19):
+//! an annulus $R_i = 0.75 \le R \le R_o = 1.25$ m on an unstructured mesh
+//! of linear triangles, E = 1 Pa, ν = 0, both rims fixed, loaded by the
+//! body force that makes the rotation field
+//!
+//! $$\theta(R) = \alpha\,\frac{16(R-R_i)^2(R-R_o)^2}{(R_i-R_o)^4}$$
+//!
+//! (eq. 44) the exact solution (method of manufactured solutions),
+//! $\alpha = 0.1$ rad over 10 equal load steps. The displacement error
+//! converges with mesh refinement at the rate of the linear basis (2) when
+//! enough points per element are used (Fig. 19).
+//!
+//! # The manufactured body force
+//! A material point at $\mathbf X = R(\cos\Theta, \sin\Theta)$ moves to
+//! $\mathbf x = R(\cos\varphi, \sin\varphi)$, $\varphi = \Theta + \theta(R)$:
+//! the radius is kept, so the current radius $r = R$. With
+//! $\mathrm d\mathbf x = \mathrm dR\,\mathbf e_r + R\,\mathrm d\varphi\,
+//! \mathbf e_\varphi$ and $\mathrm d\varphi = \mathrm d\Theta +
+//! \theta'\mathrm dR$,
+//!
+//! $$\mathbf F = \mathbf Q\,(\mathbf I + \gamma\,\mathbf e_\Theta\otimes
+//! \mathbf e_R), \qquad \gamma(R) = R\,\theta'(R),$$
+//!
+//! where $\mathbf Q$ rotates $(\mathbf e_R, \mathbf e_\Theta)$ onto
+//! $(\mathbf e_r, \mathbf e_\varphi)$: a rigid rotation of a simple shear
+//! of amount $\gamma$ with shear direction $\mathbf e_\Theta$ and normal
+//! $\mathbf e_R$. $\det\mathbf F = 1$. Hencky elasticity is isotropic, so
+//! the Cauchy stress is the rotated simple-shear stress; for an isochoric
+//! shear it does not depend on $\lambda$ (the log strain is traceless):
+//!
+//! $$\sigma_{\varphi\varphi} = -\sigma_{rr} = s_{11}(\gamma) = 2\mu\,
+//! \frac{\gamma\,\mathrm{asinh}(\gamma/2)}{\sqrt{\gamma^2+4}},\qquad
+//! \sigma_{r\varphi} = s_{12}(\gamma) = 2\mu\,\frac{2\,\mathrm{asinh}(\gamma/2)}
+//! {\sqrt{\gamma^2+4}}$$
+//!
+//! (the closed form of the shear case). The fields depend on $r$ only, so
+//! equilibrium in polar coordinates, $\nabla\cdot\boldsymbol\sigma +
+//! \mathbf b = \mathbf 0$, gives the body force per current volume
+//!
+//! $$b_r = s_{11}'(\gamma)\,\gamma' + \frac{2 s_{11}}{r},\qquad
+//! b_\varphi = -s_{12}'(\gamma)\,\gamma' - \frac{2 s_{12}}{r},\qquad
+//! \gamma' = \theta' + r\,\theta'',$$
+//!
+//! with $s_{11}' = 2\mu\,[\gamma/(\gamma^2+4) + 4\,\mathrm{asinh}(\gamma/2)/
+//! (\gamma^2+4)^{3/2}]$ and $s_{12}' = 2\mu\,[2/(\gamma^2+4) -
+//! 2\gamma\,\mathrm{asinh}(\gamma/2)/(\gamma^2+4)^{3/2}]$. Since $J = 1$
+//! it is also the force per reference volume, so point $p$ carries
+//! $\mathbf b(\mathbf X_p)\,V^0_p$ at the load's current $\alpha$,
+//! directed along $(\mathbf e_r, \mathbf e_\varphi)$ at the current angle.
+//! The tests check $s_{11}', s_{12}'$ against finite differences and
+//! $\mathbf b$ against a finite-difference divergence of the stress that
+//! the constitutive update computes from $\mathbf F$.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use mpm_basis::LinearSimplex;
+use mpm_constitutive::HenckyElastic;
+use mpm_mesh::{AnnulusMesh, GmshElements, SimplexMesh, read_msh};
+use mpm_solver::{
+    BodyForcePath, Formulation, LoadStepping, NewtonOptions, NodalConstraints, PreviouslyConverged,
+    SolverError, StepReport, UpdatedLagrangian,
+};
+use nalgebra::Vector2;
+use serde::{Deserialize, Serialize};
+
+use crate::body::{Body, SimplexRule};
+use crate::run::{Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
+use crate::variant::{BasisKind, DomainUpdateKind, FormulationKind, LockingKind, Variant};
+
+/// The rotation field of eq. (44) and its manufactured body force.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Torsion {
+    /// Inner radius $R_i$.
+    pub inner_radius: f64,
+    /// Outer radius $R_o$.
+    pub outer_radius: f64,
+    /// Shear modulus $\mu$.
+    pub mu: f64,
+}
+
+impl Torsion {
+    /// $(\theta, \theta', \theta'')$ at radius `r` for amplitude `alpha`.
+    pub fn theta(&self, alpha: f64, r: f64) -> (f64, f64, f64) {
+        let (a, b) = (self.inner_radius, self.outer_radius);
+        let c = 16.0 * alpha / (a - b).powi(4);
+        let (p, q) = (r - a, r - b);
+        (
+            c * p * p * q * q,
+            c * 2.0 * p * q * (p + q),
+            c * 2.0 * (q * q + 4.0 * p * q + p * p),
+        )
+    }
+
+    /// The exact displacement of the point initially at `x0`.
+    pub fn displacement(&self, alpha: f64, x0: &Vector2<f64>) -> Vector2<f64> {
+        let r = x0.norm();
+        let (t, _, _) = self.theta(alpha, r);
+        let (s, c) = t.sin_cos();
+        Vector2::new(c * x0[0] - s * x0[1], s * x0[0] + c * x0[1]) - x0
+    }
+
+    /// The simple-shear stresses $(s_{11}, s_{12})$ and their derivatives
+    /// with respect to $\gamma$.
+    pub fn shear_stress(&self, gamma: f64) -> ((f64, f64), (f64, f64)) {
+        let a = (gamma / 2.0).asinh();
+        let q = gamma * gamma + 4.0;
+        let root = q.sqrt();
+        let m = 2.0 * self.mu;
+        (
+            (m * a * gamma / root, m * 2.0 * a / root),
+            (
+                m * (gamma / q + 4.0 * a / (q * root)),
+                m * (2.0 / q - 2.0 * gamma * a / (q * root)),
+            ),
+        )
+    }
+
+    /// The body force per unit volume, in Cartesian components, that holds
+    /// the point initially at `x0` in equilibrium at amplitude `alpha`.
+    pub fn body_force(&self, alpha: f64, x0: &Vector2<f64>) -> Vector2<f64> {
+        let r = x0.norm();
+        let (t, dt, ddt) = self.theta(alpha, r);
+        let gamma = r * dt;
+        let dgamma = dt + r * ddt;
+        let ((s11, s12), (ds11, ds12)) = self.shear_stress(gamma);
+        let b_r = ds11 * dgamma + 2.0 * s11 / r;
+        let b_phi = -ds12 * dgamma - 2.0 * s12 / r;
+        let phi = x0[1].atan2(x0[0]) + t;
+        let (s, c) = phi.sin_cos();
+        Vector2::new(c * b_r - s * b_phi, s * b_r + c * b_phi)
+    }
+}
+
+crate::case_params! {
+    /// Parameters of the annulus case (defaults: the paper's values).
+    pub struct AnnulusParams {
+        /// Target element size h (m): the generated mesh has
+        /// round((R_o − R_i)/h) layers and round(2π R_o/h) nodes per ring.
+        pub h: f64 = 0.125,
+        /// Material points per triangle: n² at the centroids of the n²
+        /// sub-triangles of n divisions per edge (the paper's 1², 2², 3², 4²).
+        pub points_per_element: usize = 3,
+        /// Inner radius R_i (m).
+        pub inner_radius: f64 = 0.75,
+        /// Outer radius R_o (m).
+        pub outer_radius: f64 = 1.25,
+        /// Rotation amplitude α (rad), eq. (44).
+        pub alpha: f64 = 0.1,
+        /// Young's modulus (Pa).
+        pub youngs_modulus: f64 = 1.0,
+        /// Poisson's ratio.
+        pub poisson_ratio: f64 = 0.0,
+        /// Number of equal load steps.
+        pub load_steps: usize = 10,
+        /// Newton tolerance on eq. (40).
+        pub tolerance: f64 = 1e-9,
+        /// Jitter of the generated mesh's interior nodes (fraction of the
+        /// radial and angular steps, at most 0.2), so that the mesh is not
+        /// structured.
+        pub jitter: f64 = 0.0,
+        /// A Gmsh MSH 4.1 file of linear triangles with physical groups
+        /// `inner` and `outer` (the rims) instead of the generated mesh;
+        /// relative paths are taken from the scene file's directory.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub mesh: Option<PathBuf> = None,
+    }
+}
+
+/// The annulus's result.
+#[derive(Debug, Clone)]
+pub struct AnnulusResult {
+    /// The run.
+    pub output: RunOutput<2>,
+    /// Volume-weighted mean displacement error (m),
+    /// $\sum_p |\mathbf u_p - \mathbf u^a(\mathbf X_p)| V^0_p / \sum_p V^0_p$.
+    pub error: f64,
+    /// Largest point displacement error (m).
+    pub max_error: f64,
+    /// Number of material points.
+    pub material_points: usize,
+    /// Number of triangles.
+    pub elements: usize,
+    /// Mean element size, $\sqrt{2A/n_e}$ (m).
+    pub element_size: f64,
+}
+
+/// The background mesh: generated, or read from `p.mesh`.
+pub fn mesh(p: &AnnulusParams) -> Result<SimplexMesh<2>, SolverError> {
+    let invalid = |e: mpm_mesh::MeshError| SolverError::InvalidInput(e.to_string());
+    if let Some(path) = &p.mesh {
+        return match read_msh::<2>(path).map_err(invalid)?.elements {
+            GmshElements::Linear(mesh) => Ok(mesh),
+            GmshElements::Quadratic(_) => Err(SolverError::InvalidInput(format!(
+                "{}: the annulus needs linear triangles (tri3)",
+                path.display()
+            ))),
+        };
+    }
+    if !(p.h > 0.0 && p.h.is_finite()) {
+        return Err(SolverError::InvalidInput(format!(
+            "h = {} must be positive",
+            p.h
+        )));
+    }
+    let radial = ((p.outer_radius - p.inner_radius) / p.h).ceil().max(2.0) as usize;
+    let ring = (2.0 * std::f64::consts::PI * p.outer_radius / p.h)
+        .round()
+        .max(8.0) as usize;
+    AnnulusMesh::new(p.inner_radius, p.outer_radius, radial, ring)
+        .with_jitter(p.jitter, 1)
+        .simplex_mesh()
+        .map_err(invalid)
+}
+
+/// Runs the annulus with `variant` (standard MPM on the triangles; UL or
+/// PC).
+pub fn run<O>(
+    p: &AnnulusParams,
+    variant: &Variant,
+    control: &RunControl,
+    observer: O,
+) -> Result<AnnulusResult, SolverError>
+where
+    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
+{
+    if variant.basis != BasisKind::Linear
+        || variant.domain_update != DomainUpdateKind::None
+        || variant.locking != LockingKind::None
+    {
+        return Err(SolverError::InvalidInput(format!(
+            "the annulus runs standard MPM on triangles: basis = linear, domain_update = none (got {} / {})",
+            variant.basis, variant.domain_update
+        )));
+    }
+    match variant.formulation {
+        FormulationKind::Pc => go::<PreviouslyConverged, _>(p, control, observer),
+        FormulationKind::Ul => go::<UpdatedLagrangian, _>(p, control, observer),
+    }
+}
+
+fn go<F: Formulation, O>(
+    p: &AnnulusParams,
+    control: &RunControl,
+    observer: O,
+) -> Result<AnnulusResult, SolverError>
+where
+    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
+{
+    let mesh = mesh(p)?;
+    let all: Vec<usize> = (0..mesh.element_count()).collect();
+    let body = Body::fill_simplices(&mesh, &all, SimplexRule::Subdivision(p.points_per_element));
+    let mut constraints = NodalConstraints::<2>::new(mesh.node_count());
+    for rim in ["inner", "outer"] {
+        let nodes = mesh.node_sets().get(rim).ok_or_else(|| {
+            SolverError::InvalidInput(format!("the mesh has no node set `{rim}` for the rims"))
+        })?;
+        constraints.fix(nodes.iter().copied(), 0);
+        constraints.fix(nodes.iter().copied(), 1);
+    }
+    let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio)
+        .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+    let torsion = Torsion {
+        inner_radius: p.inner_radius,
+        outer_radius: p.outer_radius,
+        mu: p.youngs_modulus / (2.0 * (1.0 + p.poisson_ratio)),
+    };
+    let (x0, v0) = (
+        Arc::new(body.position.clone()),
+        Arc::new(body.volume.clone()),
+    );
+    let alpha = p.alpha;
+    let force = {
+        let (x0, v0) = (Arc::clone(&x0), Arc::clone(&v0));
+        BodyForcePath(Arc::new(move |q: usize, lambda: f64| {
+            torsion.body_force(lambda * alpha, &x0[q]) * v0[q]
+        }))
+    };
+    let (elements, area) = (mesh.element_count(), mesh.total_volume());
+    let setup = Setup {
+        grid: mesh,
+        body: &body,
+        density: 0.0,
+        law,
+        loads: Loads {
+            gravity: None,
+            point_forces: Vec::new(),
+            body_force_path: Some(force),
+        },
+        constraints,
+        stepping: LoadStepping::uniform(p.load_steps),
+        newton: NewtonOptions {
+            tolerance: p.tolerance,
+            ..NewtonOptions::default()
+        },
+    };
+    let output = simulate::<2, LinearSimplex, F, mpm_solver::NoUpdate, _, _, _>(
+        setup,
+        LinearSimplex,
+        mpm_solver::NoUpdate,
+        control,
+        observer,
+    )?;
+    let (mut sum, mut max) = (0.0f64, 0.0f64);
+    for (q, u) in output.last.displacement.iter().enumerate() {
+        let exact = torsion.displacement(alpha, &x0[q]);
+        let e = (Vector2::new(u[0], u[1]) - exact).norm();
+        sum += e * v0[q];
+        max = max.max(e);
+    }
+    Ok(AnnulusResult {
+        error: sum / v0.iter().sum::<f64>(),
+        max_error: max,
+        material_points: body.len(),
+        elements,
+        element_size: (2.0 * area / elements as f64).sqrt(),
+        output,
+    })
+}
