@@ -13,7 +13,7 @@ use std::time::Duration;
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use mpm_cases::cases::{annulus, cantilever, collapse, column, shear};
+use mpm_cases::cases::{annulus, cantilever, collapse, column, shear, stretch};
 use mpm_cases::checkpoint;
 use mpm_cases::output::CellMesh;
 use mpm_cases::run::{RunControl, Snapshot};
@@ -65,7 +65,7 @@ enum Command {
     },
 }
 
-const CASES: [(&str, &str); 5] = [
+const CASES: [(&str, &str); 6] = [
     (
         "column",
         "Coombs 2020 §7.1: elastic column compacting under self weight (analytic eq. 41, error eq. 42)",
@@ -86,6 +86,10 @@ const CASES: [(&str, &str); 5] = [
         "collapse",
         "Coombs 2020 §7.5: elasto-plastic collapse of a block (Tables 6-7)",
     ),
+    (
+        "stretch",
+        "Wang 2021 §5.3: simple stretch of a cube on tetrahedra with a moving mesh (Table 1)",
+    ),
 ];
 
 fn main() {
@@ -105,6 +109,7 @@ fn run_cli(cli: Cli) -> Result<()> {
                     "shear" => toml::to_string(&shear::ShearParams::default()),
                     "cantilever" => toml::to_string(&cantilever::CantileverParams::default()),
                     "annulus" => toml::to_string(&annulus::AnnulusParams::default()),
+                    "stretch" => toml::to_string(&stretch::StretchParams::default()),
                     _ => toml::to_string(&collapse::CollapseParams::default()),
                 }?;
                 for line in defaults.lines() {
@@ -172,6 +177,7 @@ fn run_cli(cli: Cli) -> Result<()> {
                 "cantilever" => cantilever_run(&parse_scene(&text, &origin, &set)?, &run),
                 "collapse" => collapse_run(&parse_scene(&text, &origin, &set)?, &run),
                 "annulus" => annulus_run(parse_scene(&text, &origin, &set)?, &run),
+                "stretch" => stretch_run(parse_scene(&text, &origin, &set)?, &run),
                 other => bail!(
                     "unknown case `{other}`; cases: {}",
                     CASES.iter().map(|c| c.0).collect::<Vec<_>>().join(", ")
@@ -490,6 +496,31 @@ fn annulus_run(mut p: annulus::AnnulusParams, run: &Run) -> Result<()> {
     results.insert("element_size".into(), json!(r.element_size));
     let s = summary(
         "annulus",
+        p.variant(),
+        r.material_points,
+        &r.output,
+        Some(r.error),
+        results,
+        &p,
+    );
+    obs.finish(s)
+}
+
+fn stretch_run(mut p: stretch::StretchParams, run: &Run) -> Result<()> {
+    run.resolve(&mut p.mesh);
+    let mesh = stretch::mesh(&p)?;
+    let (mut obs, control) = run.start(&p, mesh)?;
+    let r = stretch::run(&p, &p.variant(), &control, |s, rep, snap| {
+        obs.step(s, rep, snap)
+    })?;
+    let mut results = Map::new();
+    results.insert("analytic_stress".into(), json!(r.analytic_stress));
+    results.insert("tau_yy_mean".into(), json!(r.tau_yy.0));
+    results.insert("tau_yy_min".into(), json!(r.tau_yy.1));
+    results.insert("tau_yy_max".into(), json!(r.tau_yy.2));
+    results.insert("elements".into(), json!(r.elements));
+    let s = summary(
+        "stretch",
         p.variant(),
         r.material_points,
         &r.output,

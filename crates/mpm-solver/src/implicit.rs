@@ -334,6 +334,8 @@ where
         }
         let reaction = self.reaction();
         self.commit(points)?;
+        // The mesh follows to the end of the step, with the points.
+        self.move_mesh(lambda1)?;
         self.remember_increment(lambda1 - lambda0);
         Ok(StepReport {
             lambda0,
@@ -350,8 +352,10 @@ where
         })
     }
 
-    /// Stage 0: a moving mesh takes its position at the step's initial load
-    /// factor ([`Constraints::move_mesh`]; nothing for a fixed mesh).
+    /// Stage 0: a moving mesh takes its position at load factor `lambda0`
+    /// ([`Constraints::move_mesh`]; nothing for a fixed mesh). Called at
+    /// the start of every step attempt and after every converged step, so
+    /// that mesh and points always belong to the same load factor.
     pub fn move_mesh(&mut self, lambda0: f64) -> Result<(), SolverError> {
         self.constraints
             .move_mesh(&mut self.mesh, lambda0)

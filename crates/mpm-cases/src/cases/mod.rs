@@ -5,3 +5,4 @@ pub mod cantilever;
 pub mod collapse;
 pub mod column;
 pub mod shear;
+pub mod stretch;
