@@ -136,13 +136,16 @@ fn the_pc_solution_satisfies_ul_equilibrium_at_every_step() {
             (step + 1) as f64 / p.load_steps as f64,
         );
         let start = points.clone();
-        let report = pc.solve_load_step(&mut points, l0, l1).unwrap();
+        pc.solve_load_step(&mut points, l0, l1).unwrap();
         let du = pc.free_increment();
         assert_eq!(ul.prepare_step(&start, l0, l1).unwrap(), du.len());
         ul.free_residual(&start, &du).unwrap();
-        let (r_pc, r_ul) = (*report.residuals.last().unwrap(), ul.normalised_residual());
+        // Eq. (40) at the converged state, in both formulations (the
+        // solver accepts a step against the largest force of the step,
+        // hence the factor 2).
+        let (r_pc, r_ul) = (pc.normalised_residual(), ul.normalised_residual());
         assert!(
-            r_ul <= options.tolerance,
+            r_ul <= 2.0 * options.tolerance,
             "step {step}: UL residual {r_ul:e}"
         );
         worst = worst.max((r_ul - r_pc).abs());

@@ -284,6 +284,7 @@ where
         self.assemble_external_force(points, lambda1);
         let mut residuals = Vec::new();
         let mut backtracked = Vec::new();
+        let mut force_scale = 0.0f64;
         loop {
             let iteration = residuals.len();
             let shortened = self.update_material_points_backtracking(points, iteration > 0);
@@ -295,7 +296,13 @@ where
                 last_residual: residuals.last().copied().unwrap_or(f64::NAN),
             })?;
             self.assemble_internal_force();
-            let residual = self.normalised_residual();
+            // Eq. (40), normalised by the largest external-plus-reaction
+            // force of the step so far: when the solution is stress free
+            // (a rigid motion imposed on the boundary) the reactions vanish
+            // with the residual and the plain ratio would stay of order one.
+            let (r, d) = self.residual_parts();
+            force_scale = force_scale.max(d);
+            let residual = ratio(r, force_scale);
             residuals.push(residual);
             if residual <= self.options.tolerance {
                 break;
@@ -765,6 +772,12 @@ where
     /// $\|f^R\| / \|f^{ext} + f^{react}\|$, the residual taken over free
     /// dofs and the reactions over prescribed ones.
     pub fn normalised_residual(&self) -> f64 {
+        let (r, d) = self.residual_parts();
+        ratio(r, d)
+    }
+
+    /// $(\|f^R\|, \|f^{ext} + f^{react}\|)$ of eq. (40).
+    fn residual_parts(&self) -> (f64, f64) {
         let (mut r2, mut d2) = (0.0, 0.0);
         for (dof, &free) in self.system.free_of_dof.iter().enumerate() {
             let (fi, fe) = (self.it.f_int[dof], self.it.f_ext[dof]);
@@ -775,13 +788,7 @@ where
                 d2 += fe * fe;
             }
         }
-        if r2 == 0.0 {
-            0.0
-        } else if d2 == 0.0 {
-            f64::INFINITY
-        } else {
-            (r2 / d2).sqrt()
-        }
+        (r2.sqrt(), d2.sqrt())
     }
 
     /// Sum of reactions per component at prescribed dofs.
@@ -988,6 +995,17 @@ where
             points.domain[p] = domain;
         }
         Ok(())
+    }
+}
+
+/// $r/d$, with $0/0 = 0$ and $r/0 = \infty$.
+fn ratio(r: f64, d: f64) -> f64 {
+    if r == 0.0 {
+        0.0
+    } else if d == 0.0 {
+        f64::INFINITY
+    } else {
+        r / d
     }
 }
 
