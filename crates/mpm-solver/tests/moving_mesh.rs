@@ -79,8 +79,8 @@ fn a_mesh_rotating_with_its_rim_turns_the_body_rigidly() {
         0.0,
         1.0,
     );
-    for p in 0..pts.len() {
-        assert!((pts.position[p] - r * x0[p]).norm() < 1e-9, "point {p}");
+    for (p, x) in x0.iter().enumerate() {
+        assert!((pts.position[p] - r * x).norm() < 1e-9, "point {p}");
         assert!((pts.f[p] - r3).norm() < 1e-9, "point {p}: F = {}", pts.f[p]);
         assert!(
             pts.sigma[p].norm() < 1e-6,
