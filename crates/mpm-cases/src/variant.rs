@@ -128,6 +128,23 @@ pub struct Variant {
 }
 
 impl Variant {
+    /// `Ok` for standard MPM without domain update or locking treatment,
+    /// the only variant of the simplex-mesh cases (`mesh` names their mesh
+    /// in the error).
+    pub fn require_standard_mpm(&self, mesh: &str) -> Result<(), String> {
+        if self.basis == BasisKind::Linear
+            && self.domain_update == DomainUpdateKind::None
+            && self.locking == LockingKind::None
+        {
+            Ok(())
+        } else {
+            Err(format!(
+                "on {mesh} the variant is standard MPM: basis = linear, domain_update = none, locking = none (got {} / {} / {})",
+                self.basis, self.domain_update, self.locking
+            ))
+        }
+    }
+
     /// The variant as it runs: CPDI2 always convects its corners, so
     /// `domain_update = none` with `basis = cpdi2` reads `cpdi2`.
     pub fn resolved(self) -> Self {

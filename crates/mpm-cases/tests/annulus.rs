@@ -167,3 +167,21 @@ fn updated_lagrangian_equals_previously_converged_on_triangles() {
         .fold(0.0, f64::max);
     assert!(worst <= 1e-8 * 0.1, "{worst:e}");
 }
+
+#[test]
+fn the_simplex_cases_refuse_grid_only_variants() {
+    use mpm_cases::variant::BasisKind;
+    let v = Variant {
+        basis: BasisKind::Gimp,
+        ..Variant::default()
+    };
+    let e = run(
+        &AnnulusParams::default(),
+        &v,
+        &RunControl::default(),
+        |_, _, _| Ok(()),
+    )
+    .err()
+    .unwrap();
+    assert!(e.to_string().contains("standard MPM"), "{e}");
+}

@@ -66,7 +66,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::body::{Body, SimplexRule};
 use crate::run::{Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
-use crate::variant::{BasisKind, DomainUpdateKind, FormulationKind, LockingKind, Variant};
+use crate::variant::{FormulationKind, Variant};
 
 /// The rotation field of eq. (44) and its manufactured body force.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -224,15 +224,9 @@ pub fn run<O>(
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    if variant.basis != BasisKind::Linear
-        || variant.domain_update != DomainUpdateKind::None
-        || variant.locking != LockingKind::None
-    {
-        return Err(SolverError::InvalidInput(format!(
-            "the annulus runs standard MPM on triangles: basis = linear, domain_update = none (got {} / {})",
-            variant.basis, variant.domain_update
-        )));
-    }
+    variant
+        .require_standard_mpm("triangles")
+        .map_err(SolverError::InvalidInput)?;
     match variant.formulation {
         FormulationKind::Pc => go::<PreviouslyConverged, _>(p, control, observer),
         FormulationKind::Ul => go::<UpdatedLagrangian, _>(p, control, observer),

@@ -37,7 +37,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::body::{Body, SimplexRule};
 use crate::run::{Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
-use crate::variant::{BasisKind, DomainUpdateKind, FormulationKind, LockingKind, Variant};
+use crate::variant::{FormulationKind, Variant};
 
 crate::case_params! {
     /// Parameters of the stretch case (defaults: Wang 2021 Table 1).
@@ -140,15 +140,9 @@ pub fn run<O>(
 where
     O: FnMut(usize, &StepReport<3>, &Snapshot) -> Result<(), SolverError>,
 {
-    if variant.basis != BasisKind::Linear
-        || variant.domain_update != DomainUpdateKind::None
-        || variant.locking != LockingKind::None
-    {
-        return Err(SolverError::InvalidInput(format!(
-            "the stretch runs standard MPM on tetrahedra: basis = linear, domain_update = none (got {} / {})",
-            variant.basis, variant.domain_update
-        )));
-    }
+    variant
+        .require_standard_mpm("tetrahedra")
+        .map_err(SolverError::InvalidInput)?;
     match variant.formulation {
         FormulationKind::Pc => go::<PreviouslyConverged, _>(p, control, observer),
         FormulationKind::Ul => go::<UpdatedLagrangian, _>(p, control, observer),
