@@ -1,89 +1,81 @@
 //! Developer tasks, run as `cargo xtask <task>` (build in release for
-//! meaningful timings: `cargo xtask` runs the release profile only if asked,
-//! so use `cargo run --release -p xtask -- <task>`).
+//! meaningful timings: `cargo xtask` runs the debug profile, so use
+//! `cargo run --release -p xtask -- <task>`).
 //!
-//! - `column-table`: error and solver time of the column (Coombs 2020 §7.1)
-//!   for h = 50/2^k, k = 2..7, 2×2 points per cell, standard MPM and GIMP
-//!   (stretch update, eq. 34), best of three runs; writes
-//!   `docs/src/benchmarks/column.md`.
+//! - `reproduce coombs2020 [--full] [--kmax K]`: the reproduction report of
+//!   Coombs et al. (2020) — column convergence per domain-update rule
+//!   (Fig. 7), error against run time, collapse extent and height (Tables
+//!   6, 7), Newton residuals (Tables 3, 8) and the cantilever against the
+//!   elastica (Figs. 13, 15, 17) — written to
+//!   `docs/src/reproduction/coombs2020.md` with PNG plots in
+//!   `docs/src/reproduction/img/` ([`coombs2020`]).
+//! - `column-table`: error and solver time of the column for standard MPM
+//!   and GIMP (eq. 34), written to `docs/src/benchmarks/column.md`
+//!   ([`column_table`]).
 
-use std::fmt::Write as _;
-use std::path::Path;
+mod column_table;
+mod coombs2020;
+mod machine;
+mod markdown;
+mod plot;
 
-use anyhow::{Result, bail};
-use mpm_cases::cases::column::{ColumnParams, run};
-use mpm_cases::run::RunControl;
-use mpm_cases::variant::{BasisKind, DomainUpdateKind};
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+const USAGE: &str = "usage: cargo run --release -p xtask -- <task>
+
+tasks:
+  reproduce coombs2020 [--full] [--kmax K]
+                Coombs et al. (2020): column convergence (Fig. 7), error against
+                run time, collapse (Tables 6-8), cantilever (Figs. 13-17, Table 3);
+                writes docs/src/reproduction/coombs2020.md and its PNG plots.
+                --full   adds the collapse with h = 0.25 m (Table 6, slow)
+                --kmax K refines the column to h = 50/2^K (2..=9, default 7)
+  column-table  error and run time of the column case, written to
+                docs/src/benchmarks/column.md
+  help          this message";
 
 fn main() -> Result<()> {
-    let mut args = std::env::args().skip(1);
-    match args.next().as_deref() {
-        None | Some("help") | Some("--help") | Some("-h") => {
-            println!(
-                "usage: cargo run --release -p xtask -- <task>\n\ntasks:\n  column-table  error and run time of the column case, written to docs/src/benchmarks/column.md"
-            );
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match args.first().map(String::as_str) {
+        None | Some("help" | "--help" | "-h") => {
+            println!("{USAGE}");
             Ok(())
         }
-        Some("column-table") => column_table(),
-        Some(other) => bail!("unknown task `{other}` (run `cargo xtask help`)"),
+        Some("column-table") => {
+            no_more_arguments(&args[1..])?;
+            column_table::run(&docs_dir())
+        }
+        Some("reproduce") => match args.get(1).map(String::as_str) {
+            Some("coombs2020") => {
+                let options = coombs2020::Options::parse(&args[2..])?;
+                coombs2020::run(&options, &docs_dir())
+            }
+            Some(other) => bail!("unknown paper `{other}`; known: coombs2020"),
+            None => bail!("`reproduce` needs a paper: `reproduce coombs2020`"),
+        },
+        Some(other) => bail!("unknown task `{other}`\n\n{USAGE}"),
     }
 }
 
-fn column_table() -> Result<()> {
-    let mut md = String::new();
-    writeln!(md, "# Column: error against run time\n")?;
-    writeln!(
-        md,
-        "Compaction under self weight (Coombs et al. 2020 §7.1): error of eq. (42) and solver wall time\n\
-         (best of three, file output excluded) for h = 50/2^k, 2×2 points per cell, 20 load steps,\n\
-         tolerance 1e-9, previously converged formulation. Regenerate with\n\
-         `cargo run --release -p xtask -- column-table` (2-core machine).\n"
-    )?;
-    writeln!(
-        md,
-        "| k | h (m) | points | standard MPM error | time (ms) | iterations | GIMP (eq. 34) error | time (ms) | iterations |"
-    )?;
-    writeln!(md, "|---|---|---|---|---|---|---|---|---|")?;
-    for k in 2..=7 {
-        let h = 50.0 / 2f64.powi(k);
-        let mut row = format!("| {k} | {h} |");
-        for (i, (basis, update)) in [
-            (BasisKind::Linear, DomainUpdateKind::None),
-            (BasisKind::Gimp, DomainUpdateKind::Stretch),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            let p = ColumnParams {
-                h,
-                basis,
-                domain_update: update,
-                ..ColumnParams::default()
-            };
-            let mut best = f64::INFINITY;
-            let mut last = None;
-            for _ in 0..3 {
-                let r = run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))?;
-                best = best.min(r.output.wall_time_s);
-                last = Some(r);
-            }
-            let Some(r) = last else { bail!("no run") };
-            if i == 0 {
-                write!(row, " {} |", r.material_points)?;
-            }
-            write!(
-                row,
-                " {:.3e} | {:.1} | {} |",
-                r.error,
-                1e3 * best,
-                r.output.summary.iterations
-            )?;
-        }
-        println!("{row}");
-        writeln!(md, "{row}")?;
+/// Fails on arguments a task does not take.
+fn no_more_arguments(rest: &[String]) -> Result<()> {
+    match rest.first() {
+        None => Ok(()),
+        Some(a) => bail!("unexpected argument `{a}`\n\n{USAGE}"),
     }
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/src/benchmarks/column.md");
-    std::fs::write(&path, md)?;
-    println!("wrote {}", path.display());
-    Ok(())
+}
+
+/// The mdBook sources, `docs/src` of the workspace.
+fn docs_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/src")
+}
+
+/// Writes `contents` to `path`, creating its folder.
+fn write_file(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
 }

@@ -1,0 +1,93 @@
+//! The MPM variants the studies compare, with the names the report uses.
+
+use mpm_cases::variant::{BasisKind, DomainUpdateKind, Variant};
+
+/// Standard MPM or GIMP with a domain-update rule, CPDI2 or the quadratic
+/// B-spline, all with the previously converged formulation (as in §7).
+pub fn variant(basis: BasisKind, domain_update: DomainUpdateKind) -> Variant {
+    Variant {
+        basis,
+        domain_update,
+        ..Variant::default()
+    }
+    .resolved()
+}
+
+/// GIMP with domain-update rule `rule`.
+pub fn gimp(rule: DomainUpdateKind) -> Variant {
+    variant(BasisKind::Gimp, rule)
+}
+
+/// CPDI2 (corners convected with the grid).
+pub fn cpdi2() -> Variant {
+    variant(BasisKind::Cpdi2, DomainUpdateKind::Cpdi2)
+}
+
+/// Standard MPM.
+pub fn linear() -> Variant {
+    variant(BasisKind::Linear, DomainUpdateKind::None)
+}
+
+/// Every GIMP rule, in the paper's order.
+pub const GIMP_RULES: [DomainUpdateKind; 8] = [
+    DomainUpdateKind::None,
+    DomainUpdateKind::DetF,
+    DomainUpdateKind::DiagF,
+    DomainUpdateKind::Stretch,
+    DomainUpdateKind::CornerMidpoint,
+    DomainUpdateKind::Midpoint,
+    DomainUpdateKind::VolumeCorrectedDiagF,
+    DomainUpdateKind::IncrementalVolumeCorrectedDiagF,
+];
+
+/// Standard MPM, the quadratic B-spline, GIMP with every rule and CPDI2.
+pub fn all() -> Vec<Variant> {
+    let mut v = vec![
+        linear(),
+        variant(BasisKind::BSpline2, DomainUpdateKind::None),
+    ];
+    v.extend(GIMP_RULES.map(gimp));
+    v.push(cpdi2());
+    v
+}
+
+/// The report's name of a variant: basis and, for GIMP, the paper's
+/// equation of the domain update.
+pub fn label(v: &Variant) -> String {
+    match v.basis {
+        BasisKind::Linear => "standard MPM".into(),
+        BasisKind::BSpline2 => "quadratic B-spline".into(),
+        BasisKind::Cpdi2 => "CPDI2".into(),
+        BasisKind::Gimp => format!("GIMP, {}", rule_label(v.domain_update)),
+    }
+}
+
+/// A short name for legends: the basis and, for GIMP, the equation.
+pub fn short_label(v: &Variant) -> String {
+    match v.basis {
+        BasisKind::Gimp => match v.domain_update {
+            DomainUpdateKind::None => "GIMP, no update".into(),
+            DomainUpdateKind::Midpoint => "GIMP (eq. 37, Fig. 5b)".into(),
+            rule => format!(
+                "GIMP ({})",
+                rule_label(rule).split(" (").next().unwrap_or("")
+            ),
+        },
+        _ => label(v),
+    }
+}
+
+/// The paper's name of a GIMP domain-update rule.
+pub fn rule_label(rule: DomainUpdateKind) -> &'static str {
+    match rule {
+        DomainUpdateKind::None => "no update",
+        DomainUpdateKind::DetF => "eq. 32 (det F)",
+        DomainUpdateKind::DiagF => "eq. 33 (F_ii)",
+        DomainUpdateKind::Stretch => "eq. 34 (U_ii)",
+        DomainUpdateKind::CornerMidpoint => "eq. 37 (corners, Fig. 5a)",
+        DomainUpdateKind::Midpoint => "eq. 37 (mid-points, Fig. 5b)",
+        DomainUpdateKind::VolumeCorrectedDiagF => "eq. 38 (volume-corrected F_ii)",
+        DomainUpdateKind::IncrementalVolumeCorrectedDiagF => "eq. 39 (incremental eq. 38)",
+        DomainUpdateKind::Cpdi2 => "convected corners",
+    }
+}
