@@ -6,7 +6,8 @@
 //!   Coombs et al. (2020) — column convergence per domain-update rule
 //!   (Fig. 7), error against run time, collapse extent and height (Tables
 //!   6, 7), Newton residuals (Tables 3, 8) and the cantilever against the
-//!   elastica (Figs. 13, 15, 17) — written to
+//!   elastica (Figs. 13, 15, 17), the annulus on unstructured triangles
+//!   (Fig. 19) — written to
 //!   `docs/src/reproduction/coombs2020.md` with PNG plots in
 //!   `docs/src/reproduction/img/` ([`coombs2020`]).
 //! - `column-table`: error and solver time of the column for standard MPM
@@ -28,9 +29,11 @@ const USAGE: &str = "usage: cargo run --release -p xtask -- <task>
 tasks:
   reproduce coombs2020 [--full] [--kmax K]
                 Coombs et al. (2020): column convergence (Fig. 7), error against
-                run time, collapse (Tables 6-8), cantilever (Figs. 13-17, Table 3);
-                writes docs/src/reproduction/coombs2020.md and its PNG plots.
-                --full   adds the collapse with h = 0.25 m (Table 6, slow)
+                run time, collapse (Tables 6-8), cantilever (Figs. 13-17, Table 3),
+                annulus on unstructured triangles (Fig. 19); writes
+                docs/src/reproduction/coombs2020.md and its PNG plots.
+                --full   adds the collapse with h = 0.25 m (Table 6) and 6², 8²
+                         points per triangle on the finest annulus meshes (slow)
                 --kmax K refines the column to h = 50/2^K (2..=9, default 7)
   column-table  error and run time of the column case, written to
                 docs/src/benchmarks/column.md

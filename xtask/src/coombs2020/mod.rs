@@ -4,6 +4,7 @@
 //! asserted by `crates/mpm-cases/tests/coombs2020.rs`; this task reports
 //! them with the paper's values beside ours.
 
+pub mod annulus;
 pub mod cantilever;
 pub mod collapse;
 pub mod column;
@@ -23,7 +24,8 @@ use crate::{machine, write_file};
 /// Command-line options of the task.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Options {
-    /// Add the collapse with h = 0.25 m to Table 6 (slow).
+    /// Add the collapse with h = 0.25 m to Table 6 and 6², 8² points per
+    /// triangle on the finest annulus meshes (slow).
     pub full: bool,
     /// Finest column refinement level, h = 50/2^kmax.
     pub kmax: i32,
@@ -79,6 +81,7 @@ pub fn run(options: &Options, docs: &Path) -> Result<()> {
     let column = column::study(options.kmax);
     let collapse = collapse::study(options.full);
     let cantilever = cantilever::study();
+    let annulus = annulus::study(options.full);
 
     let mut md = String::new();
     writeln!(
@@ -109,6 +112,7 @@ pub fn run(options: &Options, docs: &Path) -> Result<()> {
     md.push_str(&collapse::table8_section(&collapse)?);
     md.push_str(&cantilever::table3_section(&cantilever)?);
     md.push_str(&cantilever::section(&cantilever, &img)?);
+    md.push_str(&annulus::section(&annulus, &img)?);
 
     let path = dir.join("coombs2020.md");
     write_file(&path, md.trim_end().to_owned() + "\n")?;
