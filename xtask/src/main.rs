@@ -10,6 +10,10 @@
 //!   (Fig. 19) — written to
 //!   `docs/src/reproduction/coombs2020.md` with PNG plots in
 //!   `docs/src/reproduction/img/` ([`coombs2020`]).
+//! - `reproduce wang2021 [--full]`: the simple stretch on tetrahedra with a
+//!   moving mesh (Table 1, standard MPM) and point location by walking
+//!   against brute force (§5.7), written to
+//!   `docs/src/reproduction/wang2021.md` ([`wang2021`]).
 //! - `column-table`: error and solver time of the column for standard MPM
 //!   and GIMP (eq. 34), written to `docs/src/benchmarks/column.md`
 //!   ([`column_table`]).
@@ -19,6 +23,7 @@ mod coombs2020;
 mod machine;
 mod markdown;
 mod plot;
+mod wang2021;
 
 use std::path::{Path, PathBuf};
 
@@ -35,6 +40,10 @@ tasks:
                 --full   adds the collapse with h = 0.25 m (Table 6) and 6², 8²
                          points per triangle on the finest annulus meshes (slow)
                 --kmax K refines the column to h = 50/2^K (2..=9, default 7)
+  reproduce wang2021 [--full]
+                Wang et al. (2021): simple stretch on tetrahedra (Table 1, standard
+                MPM) and walking point location (§5.7); writes
+                docs/src/reproduction/wang2021.md. --full adds 16 subdivisions.
   column-table  error and run time of the column case, written to
                 docs/src/benchmarks/column.md
   help          this message";
@@ -55,8 +64,18 @@ fn main() -> Result<()> {
                 let options = coombs2020::Options::parse(&args[2..])?;
                 coombs2020::run(&options, &docs_dir())
             }
-            Some(other) => bail!("unknown paper `{other}`; known: coombs2020"),
-            None => bail!("`reproduce` needs a paper: `reproduce coombs2020`"),
+            Some("wang2021") => {
+                let full = match &args[2..] {
+                    [] => false,
+                    [flag] if flag == "--full" => true,
+                    [other, ..] => bail!("unexpected argument `{other}` (expected --full)"),
+                };
+                wang2021::run_report(full, &docs_dir())
+            }
+            Some(other) => bail!("unknown paper `{other}`; known: coombs2020, wang2021"),
+            None => {
+                bail!("`reproduce` needs a paper: `reproduce coombs2020` or `reproduce wang2021`")
+            }
         },
         Some(other) => bail!("unknown task `{other}`\n\n{USAGE}"),
     }
