@@ -117,7 +117,7 @@ fn run_cli(cli: Cli) -> Result<()> {
                 }
             }
             println!(
-                "\nvariant values: basis = {}; formulation = ul | pc; domain_update = {}",
+                "\nvariant values: basis = {}; formulation = ul | pc; domain_update = {}; gimp_volume = det_f | domain",
                 BasisKind::ALL
                     .iter()
                     .map(|b| b.name())
@@ -348,12 +348,13 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
         self.bar.finish_and_clear();
         self.writer.summary(&summary)?;
         println!(
-            "{} [{} {} {} {}]: {} points, {} steps ({} cut), {} Newton iterations, {:.3} s{}",
+            "{} [{} {} {} {}{}]: {} points, {} steps ({} cut), {} Newton iterations, {:.3} s{}",
             summary.case,
             summary.variant.basis,
             summary.variant.formulation,
             summary.variant.locking,
             summary.variant.domain_update,
+            summary.variant.gimp_volume_note(),
             summary.material_points,
             summary.load_steps,
             summary.cut_steps,

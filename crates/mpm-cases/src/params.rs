@@ -28,6 +28,8 @@ macro_rules! case_params {
             pub locking: $crate::variant::LockingKind,
             /// GIMP domain update.
             pub domain_update: $crate::variant::DomainUpdateKind,
+            /// Integration volume of GIMP points.
+            pub gimp_volume: $crate::variant::GimpVolumeKind,
         }
 
         impl Default for $name {
@@ -40,6 +42,7 @@ macro_rules! case_params {
                     formulation: v.formulation,
                     locking: v.locking,
                     domain_update: v.domain_update,
+                    gimp_volume: v.gimp_volume,
                 }
             }
         }
@@ -52,6 +55,7 @@ macro_rules! case_params {
                     formulation: self.formulation,
                     locking: self.locking,
                     domain_update: self.domain_update,
+                    gimp_volume: self.gimp_volume,
                 }
             }
         }

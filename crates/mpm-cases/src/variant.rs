@@ -8,7 +8,7 @@ use std::str::FromStr;
 use mpm_basis::{Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    ConvectedCorners, CornerMidpoint, DetF, DiagF, DomainUpdater, Flat, Formulation,
+    ConvectedCorners, CornerMidpoint, DetF, DiagF, DomainUpdater, DomainVolume, Flat, Formulation,
     IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, PreviouslyConverged, StretchU,
     UpdatedLagrangian, VolumeCorrectedDiagF,
 };
@@ -107,6 +107,17 @@ named_enum!(
 );
 
 named_enum!(
+    /// The integration volume of GIMP points.
+    GimpVolumeKind {
+        /// $\det(F)\,V^0_p$ (eqs. 5, 22), the default.
+        DetF => "det_f",
+        /// The domain's volume $\prod_i 2l_i$: the convention of Coombs et
+        /// al. 2020's GIMP results (`mpm_solver::DomainVolume`).
+        Domain => "domain",
+    }
+);
+
+named_enum!(
     /// Locking treatments.
     LockingKind {
         /// Standard: none.
@@ -125,6 +136,13 @@ pub struct Variant {
     pub locking: LockingKind,
     /// Domain update.
     pub domain_update: DomainUpdateKind,
+    /// Integration volume of GIMP points.
+    #[serde(default = "default_gimp_volume")]
+    pub gimp_volume: GimpVolumeKind,
+}
+
+fn default_gimp_volume() -> GimpVolumeKind {
+    GimpVolumeKind::DetF
 }
 
 impl Variant {
@@ -142,6 +160,15 @@ impl Variant {
                 "on {mesh} the variant is standard MPM: basis = linear, domain_update = none, locking = none (got {} / {} / {})",
                 self.basis, self.domain_update, self.locking
             ))
+        }
+    }
+
+    /// ` domain-volume` when GIMP points integrate with their domain's
+    /// volume, else nothing (for one-line summaries).
+    pub fn gimp_volume_note(&self) -> &'static str {
+        match self.gimp_volume {
+            GimpVolumeKind::DetF => "",
+            GimpVolumeKind::Domain => " domain-volume",
         }
     }
 
@@ -165,6 +192,7 @@ impl Default for Variant {
             formulation: FormulationKind::Pc,
             locking: LockingKind::None,
             domain_update: DomainUpdateKind::None,
+            gimp_volume: GimpVolumeKind::DetF,
         }
     }
 }
@@ -206,6 +234,12 @@ pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
         }
     }
     let f = variant.formulation;
+    if variant.basis != BasisKind::Gimp && variant.gimp_volume != GimpVolumeKind::DetF {
+        return Err(format!(
+            "gimp_volume = {} applies to basis = gimp",
+            variant.gimp_volume
+        ));
+    }
     let no_domain = |name: &str| {
         if variant.domain_update == DomainUpdateKind::None {
             Ok(())
@@ -234,26 +268,41 @@ pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
             )),
         },
         BasisKind::Gimp => {
-            let v = visitor;
-            Ok(match variant.domain_update {
-                DomainUpdateKind::None => with_formulation(f, v, Gimp, NoUpdate),
-                DomainUpdateKind::DetF => with_formulation(f, v, Gimp, DetF),
-                DomainUpdateKind::DiagF => with_formulation(f, v, Gimp, DiagF),
-                DomainUpdateKind::Stretch => with_formulation(f, v, Gimp, StretchU),
-                DomainUpdateKind::CornerMidpoint => with_formulation(f, v, Gimp, CornerMidpoint),
-                DomainUpdateKind::Midpoint => with_formulation(f, v, Gimp, Midpoint),
-                DomainUpdateKind::VolumeCorrectedDiagF => {
-                    with_formulation(f, v, Gimp, VolumeCorrectedDiagF)
-                }
-                DomainUpdateKind::IncrementalVolumeCorrectedDiagF => {
-                    with_formulation(f, v, Gimp, IncrementalVolumeCorrectedDiagF)
-                }
-                DomainUpdateKind::Cpdi2 => {
-                    return Err(
-                        "domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2"
-                            .into(),
-                    );
-                }
+            // The rules, each wrapped by `$wrap` (the identity, or the
+            // domain's volume as the points' integration volume).
+            macro_rules! rules {
+                ($wrap:expr) => {
+                    match variant.domain_update {
+                        DomainUpdateKind::None => with_formulation(f, visitor, Gimp, $wrap(NoUpdate)),
+                        DomainUpdateKind::DetF => with_formulation(f, visitor, Gimp, $wrap(DetF)),
+                        DomainUpdateKind::DiagF => with_formulation(f, visitor, Gimp, $wrap(DiagF)),
+                        DomainUpdateKind::Stretch => {
+                            with_formulation(f, visitor, Gimp, $wrap(StretchU))
+                        }
+                        DomainUpdateKind::CornerMidpoint => {
+                            with_formulation(f, visitor, Gimp, $wrap(CornerMidpoint))
+                        }
+                        DomainUpdateKind::Midpoint => {
+                            with_formulation(f, visitor, Gimp, $wrap(Midpoint))
+                        }
+                        DomainUpdateKind::VolumeCorrectedDiagF => {
+                            with_formulation(f, visitor, Gimp, $wrap(VolumeCorrectedDiagF))
+                        }
+                        DomainUpdateKind::IncrementalVolumeCorrectedDiagF => with_formulation(
+                            f,
+                            visitor,
+                            Gimp,
+                            $wrap(IncrementalVolumeCorrectedDiagF),
+                        ),
+                        DomainUpdateKind::Cpdi2 => {
+                            return Err("domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2".into());
+                        }
+                    }
+                };
+            }
+            Ok(match variant.gimp_volume {
+                GimpVolumeKind::DetF => rules!(std::convert::identity),
+                GimpVolumeKind::Domain => rules!(DomainVolume),
             })
         }
     }

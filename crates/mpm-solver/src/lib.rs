@@ -27,7 +27,8 @@ pub use boundary::{Constraints, NodalConstraints, StepView};
 pub use checkpoint::Flat;
 pub use domain::{
     ConvectedCorners, CornerMidpoint, DetF, DiagF, DomainContext, DomainError, DomainUpdater,
-    IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, StretchU, VolumeCorrectedDiagF,
+    DomainVolume, IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, StretchU,
+    VolumeCorrectedDiagF,
 };
 pub use error::{SolverError, StepFailure};
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
