@@ -324,7 +324,8 @@ fn table7_commentary(study: &Study) -> String {
          digits (13.769 m) while the heights differ by 2.2 %. We tried eq. 37 without its \
          volume correction, with the corners convected by the GIMP weights instead of the \
          grid's shape functions, with the corners carried from step to step instead of \
-         rebuilt from the rectangle, and as the direct mid-point variant (Fig. 5b): none gives \
+         rebuilt from the rectangle, with the extents of the corners instead of the \
+         mid-points, and as the direct mid-point variant (Fig. 5b): none gives \
          the paper's height. The paper's text says eqs. 38/39 give \"similar extent and \
          maximum height values as the (34) and (37) domain updating methods\", consistent \
          with our result, so we leave the difference as an open discrepancy rather than tune \
