@@ -72,11 +72,13 @@ pub struct Summary<P: Serialize> {
     pub parameters: P,
 }
 
-/// Columns of `steps.csv`: reactions per component of the dimension.
+/// Columns of `steps.csv`: reactions per component of the dimension, and
+/// the iteration-0 out-of-balance force as the Coombs et al. (2020) tables
+/// print it (`StepReport::initial_unbalance`).
 fn step_columns(dim: usize) -> Vec<&'static str> {
     let mut columns = vec!["step", "load_factor", "iterations"];
     columns.extend(["reaction_x", "reaction_y", "reaction_z"].iter().take(dim));
-    columns.extend(["active_nodes", "free_dofs"]);
+    columns.extend(["active_nodes", "free_dofs", "initial_unbalance"]);
     columns
 }
 
@@ -197,6 +199,9 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
         row.extend([
             CsvValue::from(report.active_nodes),
             CsvValue::from(report.free_dofs),
+            report
+                .initial_unbalance
+                .map_or(CsvValue::Str("".into()), CsvValue::from),
         ]);
         self.steps.push_row(&row)?;
         self.steps.write(&self.dir.join("steps.csv"))?;

@@ -114,6 +114,14 @@ pub struct StepReport<const D: usize> {
     pub lambda1: f64,
     /// Normalised residual (eq. 40) at iterations 0, 1, ...
     pub residuals: Vec<f64>,
+    /// The out-of-balance force at iteration 0 measured before the
+    /// reactions are known, $\|f^{ext} - f^{int}\| / \|f^{ext}\|$ over
+    /// every active dof, prescribed ones included: the first residual the
+    /// authors' code prints, so the iteration-0 row of Coombs et al.
+    /// (2020) Tables 3 and 8. Not a convergence measure: at prescribed
+    /// dofs $f^{int}$ carries the reactions of the previous step. `None`
+    /// when the step has no external force (displacement-driven steps).
+    pub initial_unbalance: Option<f64>,
     /// Sum of the reactions at prescribed dofs, per component.
     pub reaction: SVector<f64, D>,
     /// Active nodes, free dofs and stiffness entries of the step.
@@ -285,6 +293,7 @@ where
         let mut residuals = Vec::new();
         let mut backtracked = Vec::new();
         let mut force_scale = 0.0f64;
+        let mut initial_unbalance = None;
         loop {
             let iteration = residuals.len();
             let shortened = self.update_material_points_backtracking(points, iteration > 0);
@@ -301,6 +310,9 @@ where
             // (a rigid motion imposed on the boundary) the reactions vanish
             // with the residual and the plain ratio would stay of order one.
             let (r, d) = self.residual_parts();
+            if iteration == 0 {
+                initial_unbalance = self.unbalance_all_dofs();
+            }
             force_scale = force_scale.max(d);
             let residual = ratio(r, force_scale);
             residuals.push(residual);
@@ -348,6 +360,7 @@ where
             lambda0,
             lambda1,
             residuals,
+            initial_unbalance,
             reaction,
             active_nodes: self.system.n_active(),
             free_dofs: self.system.n_free,
@@ -789,6 +802,19 @@ where
             }
         }
         (r2.sqrt(), d2.sqrt())
+    }
+
+    /// $\|f^{ext} - f^{int}\| / \|f^{ext}\|$ over every active dof
+    /// (see [`StepReport::initial_unbalance`]); `None` without external
+    /// force or when not finite.
+    fn unbalance_all_dofs(&self) -> Option<f64> {
+        let (mut r2, mut e2) = (0.0, 0.0);
+        for (fi, fe) in self.it.f_int.iter().zip(&self.it.f_ext) {
+            r2 += (fe - fi) * (fe - fi);
+            e2 += fe * fe;
+        }
+        let u = r2.sqrt() / e2.sqrt();
+        (e2 > 0.0 && u.is_finite()).then_some(u)
     }
 
     /// Sum of reactions per component at prescribed dofs.
