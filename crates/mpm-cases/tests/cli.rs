@@ -158,6 +158,14 @@ fn bad_input_fails_cleanly() {
             "Young's modulus",
         ),
         (vec!["run"], "no case"),
+        (
+            vec!["run", "--case", "column", "--set", "gimp_volume=domain"],
+            "gimp_volume = domain applies to basis = gimp",
+        ),
+        (
+            vec!["run", "--case", "column", "--set", "gimp_volume=corners"],
+            "unknown variant",
+        ),
     ] {
         let (ok, _, err) = mpm(&args);
         assert!(!ok, "{args:?} should fail");
