@@ -62,6 +62,11 @@ enum Command {
         /// `--resume`.
         #[arg(long, value_name = "N")]
         stop_after: Option<usize>,
+        /// Write each step's last assembled stiffness over the free dofs
+        /// as a Matrix Market file `tangent_NNNN.mtx` (for conditioning or
+        /// eigenvalue studies in other tools).
+        #[arg(long)]
+        export_tangent: bool,
     },
 }
 
@@ -138,6 +143,7 @@ fn run_cli(cli: Cli) -> Result<()> {
             out,
             resume,
             stop_after,
+            export_tangent,
         } => {
             let (text, origin) = match &scene {
                 Some(path) => (
@@ -165,6 +171,7 @@ fn run_cli(cli: Cli) -> Result<()> {
                 out,
                 resume,
                 stop_after,
+                export_tangent,
                 scene_dir: scene
                     .as_deref()
                     .and_then(|p| p.parent())
@@ -209,6 +216,7 @@ struct Run {
     out: PathBuf,
     resume: bool,
     stop_after: Option<usize>,
+    export_tangent: bool,
     /// Directory of the scene file: relative mesh paths start there.
     scene_dir: PathBuf,
 }
@@ -252,6 +260,7 @@ impl Run {
         let control = RunControl {
             checkpoint: true,
             resume,
+            export_tangent: self.export_tangent,
         };
         let mut observer = Observer::new(writer, self.case.clone(), parameters)?;
         observer.stop_after = self.stop_after;

@@ -87,6 +87,10 @@ pub struct Snapshot {
     /// Everything needed to resume after this step, when the run was asked
     /// for checkpoints ([`RunControl::checkpoint`]).
     pub checkpoint: Option<Checkpoint>,
+    /// The step's last assembled stiffness over the free dofs, when the run
+    /// was asked for it ([`RunControl::export_tangent`]) and the step
+    /// assembled one.
+    pub tangent: Option<sprs::CsMat<f64>>,
 }
 
 /// The state of a run between two steps, from which it can be resumed with
@@ -115,6 +119,9 @@ pub struct RunControl {
     pub checkpoint: bool,
     /// Continue from this checkpoint instead of starting at load factor 0.
     pub resume: Option<Checkpoint>,
+    /// Attach each step's assembled stiffness to its [`Snapshot`] (for
+    /// Matrix Market export).
+    pub export_tangent: bool,
 }
 
 impl Snapshot {
@@ -159,6 +166,7 @@ impl Snapshot {
                 .collect(),
             mesh_nodes: None,
             checkpoint: None,
+            tangent: None,
         }
     }
 }
@@ -305,6 +313,9 @@ where
                     wall_time_s: earlier_time + start.elapsed().as_secs_f64() - observer_time,
                     case_state: Vec::new(),
                 });
+            }
+            if control.export_tangent {
+                snapshot.tangent = now.stiffness.map(|k| k.to_sprs()).transpose()?;
             }
             observer(step, report, &snapshot)?;
             observer_time += t.elapsed().as_secs_f64();

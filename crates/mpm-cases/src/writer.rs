@@ -11,7 +11,8 @@ use serde::Serialize;
 
 use crate::CasesError;
 use crate::output::{
-    CellMesh, CsvTable, CsvValue, PvdSeries, PvdStep, UnstructuredGrid, Values, write_summary,
+    CellMesh, CsvTable, CsvValue, PvdSeries, PvdStep, UnstructuredGrid, Values, atomic_write_with,
+    write_summary,
 };
 use crate::run::Snapshot;
 use crate::variant::Variant;
@@ -186,6 +187,10 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
         vtu.write(&path)?;
         self.points.push(report.lambda1, &path)?;
 
+        if let Some(k) = &snap.tangent {
+            let path = self.dir.join(format!("tangent_{step:04}.mtx"));
+            atomic_write_with(&path, |w| sprs::io::write_matrix_market_to_bufwrite(w, k))?;
+        }
         let grid_path = self.dir.join(format!("grid_{step:04}.vtu"));
         self.write_active_grid(&grid_path, snap)?;
         self.cells.push(report.lambda1, &grid_path)?;

@@ -143,6 +143,41 @@ impl<const D: usize> StepReport<D> {
     }
 }
 
+/// The stiffness over the free dofs as last assembled: compressed sparse
+/// columns, the full (not triangular) pattern, rows ascending within each
+/// column, free dofs numbered as in [`ImplicitSolver::free_increment`].
+#[derive(Debug, Clone, Copy)]
+pub struct FreeStiffness<'a> {
+    /// Free dofs (rows and columns).
+    pub n: usize,
+    /// Column pointers (`n + 1`).
+    pub col_ptr: &'a [usize],
+    /// Row index of each entry.
+    pub row_idx: &'a [usize],
+    /// Value of each entry.
+    pub values: &'a [f64],
+}
+
+impl FreeStiffness<'_> {
+    /// A copy as a `sprs` matrix (for export or inspection), checked for
+    /// a consistent structure.
+    ///
+    /// # Errors
+    /// [`SolverError::InvalidInput`] if the arrays do not form a CSC matrix
+    /// (which would be a bug of the assembly).
+    pub fn to_sprs(&self) -> Result<sprs::CsMat<f64>, SolverError> {
+        sprs::CsMat::try_new_csc(
+            (self.n, self.n),
+            self.col_ptr.to_vec(),
+            self.row_idx.to_vec(),
+            self.values.to_vec(),
+        )
+        .map_err(|(.., e)| {
+            SolverError::InvalidInput(format!("the assembled stiffness is not a CSC matrix: {e}"))
+        })
+    }
+}
+
 /// Failure of one attempt at a load step.
 #[derive(Debug, Clone, PartialEq)]
 pub enum StepError {
@@ -177,6 +212,8 @@ struct Iterate<const D: usize, H> {
     mapped: Vec<SVector<f64, D>>,
     increments: Vec<Matrix3<f64>>,
     volumes: Vec<f64>,
+    /// `values` holds a stiffness assembled on the current system.
+    stiffness_assembled: bool,
 }
 
 impl<const D: usize, H> Default for Iterate<D, H> {
@@ -193,6 +230,7 @@ impl<const D: usize, H> Default for Iterate<D, H> {
             mapped: Vec::new(),
             increments: Vec::new(),
             volumes: Vec::new(),
+            stiffness_assembled: false,
         }
     }
 }
@@ -505,6 +543,7 @@ where
         it.f_ext.resize(n_dofs, 0.0);
         it.values.clear();
         it.values.resize(sys.row_idx.len(), 0.0);
+        it.stiffness_assembled = false;
         let symmetric = L::SYMMETRIC_TANGENT && !K::COUPLES_POINTS;
         self.linear = Some(
             LinearSolver::new(
@@ -908,6 +947,19 @@ where
             }
         };
         split_blocks(0, n, &mut self.it.values, 0, &sys.block_ptr, &block);
+        self.it.stiffness_assembled = true;
+    }
+
+    /// The stiffness last assembled on the current load step's system (in
+    /// a converged step: at the last iterate before the final correction),
+    /// or `None` if the step converged without assembling one.
+    pub fn free_stiffness(&self) -> Option<FreeStiffness<'_>> {
+        self.it.stiffness_assembled.then(|| FreeStiffness {
+            n: self.system.n_free,
+            col_ptr: &self.system.col_ptr,
+            row_idx: &self.system.row_idx,
+            values: &self.it.values,
+        })
     }
 
     /// Stage 4e: solve $K\,\delta d = -f^R$ (eq. 26) and accumulate the

@@ -32,7 +32,7 @@ pub use domain::{
 };
 pub use error::{SolverError, StepFailure};
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
-pub use implicit::{ImplicitSolver, NewtonOptions, StepError, StepReport};
+pub use implicit::{FreeStiffness, ImplicitSolver, NewtonOptions, StepError, StepReport};
 pub use linear::{Factorisation, LinearSolver};
 pub use locking::{LockingTreatment, NoLocking};
 pub use mesh::{MovableMesh, NodalMesh};

@@ -10,7 +10,7 @@ use crate::boundary::Constraints;
 use crate::domain::DomainUpdater;
 use crate::error::SolverError;
 use crate::formulation::Formulation;
-use crate::implicit::{ImplicitSolver, StepError, StepReport};
+use crate::implicit::{FreeStiffness, ImplicitSolver, StepError, StepReport};
 use crate::locking::LockingTreatment;
 use crate::mesh::MovableMesh;
 use crate::points::MaterialPoints;
@@ -75,6 +75,8 @@ pub struct StepContext<'a, M> {
     /// The background mesh the step was solved on (it moves with
     /// moving-mesh conditions).
     pub mesh: &'a M,
+    /// [`ImplicitSolver::free_stiffness`] of the step.
+    pub stiffness: Option<FreeStiffness<'a>>,
 }
 
 /// What a whole analysis did.
@@ -174,6 +176,7 @@ where
                         state: now,
                         predictor: self.predictor_state(),
                         mesh: &self.mesh,
+                        stiffness: self.free_stiffness(),
                     };
                     observer(summary.steps - 1, &report, points, &context)?;
                 }

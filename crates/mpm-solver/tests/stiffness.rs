@@ -65,6 +65,14 @@ where
     let n = solver.prepare_step(&points, 0.0, 1.0).unwrap();
     let du: Vec<f64> = (0..n).map(|k| 0.02 * ((k * 31 + 7) as f64).sin()).collect();
     let k = solver.free_stiffness_dense(&points, &du).unwrap();
+    // The sparse export holds exactly the same entries, and nothing else.
+    let sparse = solver.free_stiffness().unwrap().to_sprs().unwrap();
+    assert_eq!(sparse.shape(), (n, n));
+    let mut exported = vec![0.0; n * n];
+    for (v, (r, c)) in sparse.iter() {
+        exported[c * n + r] += *v;
+    }
+    assert_eq!(exported, k);
     let step = 1e-6;
     let mut worst = 0.0f64;
     for c in 0..n {
