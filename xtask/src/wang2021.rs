@@ -13,7 +13,7 @@ use anyhow::Result;
 use mpm_cases::cases::stretch::{StretchParams, run};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::Variant;
-use mpm_mesh::{BoxMesh, SimplexMesh};
+use mpm_mesh::{BoxMesh, SimplexMesh, SplitMix64};
 use nalgebra::Vector3;
 
 use crate::markdown::{Table, millis, sci};
@@ -181,24 +181,10 @@ fn stretch_section(full: bool) -> Result<String> {
     Ok(md)
 }
 
-/// SplitMix64 in [0, 1).
-struct Random(u64);
-
-impl Random {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// One point per element: its centroid moved by 0.3 element sizes in a
 /// random direction (clamped into the box), and the element as hint.
 fn displaced(mesh: &SimplexMesh<3>) -> Vec<(Vector3<f64>, usize)> {
-    let mut random = Random(7);
+    let mut random = SplitMix64(7);
     (0..mesh.element_count())
         .map(|e| {
             let c = mesh
@@ -208,8 +194,7 @@ fn displaced(mesh: &SimplexMesh<3>) -> Vec<(Vector3<f64>, usize)> {
                 .sum::<Vector3<f64>>()
                 / 4.0;
             let size = (6.0 * mesh.volumes()[e]).cbrt();
-            let d = Vector3::new(random.next(), random.next(), random.next()) * 2.0
-                - Vector3::repeat(1.0);
+            let d = Vector3::from_fn(|_, _| random.symmetric());
             let x = (c + d.normalize() * 0.3 * size).map(|v| v.clamp(0.0, 2.0));
             (x, e)
         })

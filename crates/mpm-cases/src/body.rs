@@ -160,9 +160,7 @@ impl SimplexRule {
 /// triangulation) are exactly $n^D$ translates and reflections of $K/n$.
 fn subdivision_centroids<const D: usize>(n: usize) -> Vec<([f64; 4], f64)> {
     let share = 1.0 / (n as f64).powi(D as i32);
-    let mut permutation: Vec<usize> = (0..D).collect();
-    let mut permutations = Vec::new();
-    permutations_of(&mut permutation, 0, &mut permutations);
+    let permutations = mpm_mesh::permutations(D);
     let mut out = Vec::new();
     for flat in 0..n.pow(D as u32) {
         let mut base = [0usize; 3];
@@ -194,18 +192,6 @@ fn subdivision_centroids<const D: usize>(n: usize) -> Vec<([f64; 4], f64)> {
         }
     }
     out
-}
-
-fn permutations_of(p: &mut Vec<usize>, k: usize, out: &mut Vec<Vec<usize>>) {
-    if k == p.len() {
-        out.push(p.clone());
-        return;
-    }
-    for i in k..p.len() {
-        p.swap(k, i);
-        permutations_of(p, k + 1, out);
-        p.swap(k, i);
-    }
 }
 
 /// How a basis builds the initial domain of a point from its position and

@@ -14,7 +14,7 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use mpm_mesh::{BoxMesh, SimplexMesh};
+use mpm_mesh::{BoxMesh, SimplexMesh, SplitMix64};
 use nalgebra::Vector3;
 
 /// Box edge of the paper's efficiency example.
@@ -26,20 +26,6 @@ const DISPLACEMENT: f64 = 0.3;
 const BRUTE_POINTS: usize = 64;
 /// Points per iteration of the scaling benchmark.
 const SCALING_POINTS: usize = 8192;
-
-/// SplitMix64 in [0, 1).
-struct Random(u64);
-
-impl Random {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 /// The cube [0, 2]^3 with `cells` cells per axis, six tetrahedra per cell.
 fn cube(cells: [usize; 3]) -> SimplexMesh<3> {
@@ -56,7 +42,7 @@ fn displaced_points(
     elements: &[usize],
     seed: u64,
 ) -> (Vec<Vector3<f64>>, Vec<usize>) {
-    let mut random = Random(seed);
+    let mut random = SplitMix64(seed);
     let points = elements
         .iter()
         .map(|&e| {
@@ -67,7 +53,7 @@ fn displaced_points(
                 / 4.0;
             let size = (6.0 * mesh.volumes()[e]).cbrt();
             let direction = loop {
-                let d = Vector3::from_fn(|_, _| 2.0 * random.next() - 1.0);
+                let d = Vector3::from_fn(|_, _| random.symmetric());
                 let n = d.norm();
                 if n > 1e-3 && n <= 1.0 {
                     break d / n;
@@ -130,9 +116,9 @@ fn scaling(c: &mut Criterion) {
     group.throughput(Throughput::Elements(SCALING_POINTS as u64));
     for n in [6, 12, 26, 55] {
         let mesh = cube([n; 3]);
-        let mut random = Random(n as u64);
+        let mut random = SplitMix64(n as u64);
         let mut elements: Vec<usize> = (0..SCALING_POINTS)
-            .map(|_| (random.next() * mesh.element_count() as f64) as usize)
+            .map(|_| (random.next_unit() * mesh.element_count() as f64) as usize)
             .collect();
         elements.sort_unstable();
         let (points, hints) = displaced_points(&mesh, &elements, 2);

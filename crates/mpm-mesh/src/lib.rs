@@ -28,16 +28,18 @@ mod generate;
 mod gmsh;
 mod patches;
 mod quadratic;
+mod random;
 mod regular_grid;
 mod sets;
 mod simplex;
 
 pub use active::BoundingBox;
 pub use error::MeshError;
-pub use generate::{AnnulusMesh, BoxMesh, DiagonalPattern};
+pub use generate::{AnnulusMesh, BoxMesh, DiagonalPattern, permutations};
 pub use gmsh::{GmshElements, GmshMesh, parse_msh, read_msh};
 pub use patches::{ActivePatches, PatchMesh};
 pub use quadratic::QuadraticMesh;
+pub use random::SplitMix64;
 pub use regular_grid::{CellLocation, CellNodes, Face, RegularGrid, Side};
 pub use sets::{MeshSets, NamedSets};
 pub use simplex::{

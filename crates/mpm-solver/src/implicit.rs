@@ -316,18 +316,8 @@ where
         lambda0: f64,
         lambda1: f64,
     ) -> Result<StepReport<D>, StepError> {
-        self.move_mesh(lambda0)?;
-        self.evaluate_basis(points)?;
-        let sys = &self.system;
-        self.constraints.begin_step(&StepView::new(
-            &points.position,
-            &sys.nodes,
-            &sys.counts,
-            sys.stride,
-        ));
-        self.build_system(&points.volume, lambda0, lambda1)?;
+        self.prepare_step(points, lambda0, lambda1)?;
         self.predict(lambda1 - lambda0);
-        self.assemble_external_force(points, lambda1);
         let mut residuals = Vec::new();
         let mut backtracked = Vec::new();
         let mut force_scale = 0.0f64;
@@ -1136,8 +1126,11 @@ where
     U: DomainUpdater<D, B::Domain>,
     C: Constraints<D>,
 {
-    /// Prepares the step from `lambda0` to `lambda1` (basis, system,
-    /// external force) without iterating; returns the number of free dofs.
+    /// A load step from `lambda0` to `lambda1` up to its Newton
+    /// iterations — mesh position, then stages 1–3 of the module docs
+    /// (basis, constraints and system, external force) —
+    /// [`Self::solve_load_step`] starts with it; returns the number of free
+    /// dofs.
     pub fn prepare_step(
         &mut self,
         points: &MaterialPoints<D, L::History, B::Domain>,

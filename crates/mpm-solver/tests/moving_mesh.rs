@@ -9,10 +9,27 @@ use mpm_basis::LinearSimplex;
 use mpm_constitutive::HenckyElastic;
 use mpm_mesh::{AnnulusMesh, SimplexMesh};
 use mpm_solver::{
-    ImplicitSolver, LoadStepping, MaterialPoints, MovingMesh, NewtonOptions, NoLocking, NoUpdate,
-    NodalConstraints, PreviouslyConverged, Rotation, Translation,
+    Constraints, ImplicitSolver, LoadStepping, MaterialPoints, MovingMesh, NewtonOptions,
+    NoLocking, NoUpdate, NodalConstraints, PreviouslyConverged, Rotation, Translation,
 };
 use nalgebra::{Matrix3, Vector2};
+
+/// Standard MPM on `mesh`, Hencky elasticity (E = 1 kPa, ν = 0.3),
+/// previously converged formulation.
+fn elastic_solver<C: Constraints<2>>(
+    mesh: SimplexMesh<2>,
+    constraints: C,
+) -> ImplicitSolver<2, LinearSimplex, PreviouslyConverged, HenckyElastic, NoLocking, NoUpdate, C> {
+    ImplicitSolver::new(
+        LinearSimplex,
+        mesh,
+        HenckyElastic::new(1e3, 0.3).unwrap(),
+        NoLocking,
+        NoUpdate,
+        constraints,
+        NewtonOptions::default(),
+    )
+}
 
 /// Points at the centroids of the elements of `mesh`.
 fn points(mesh: &SimplexMesh<2>) -> MaterialPoints<2, (), ()> {
@@ -44,24 +61,7 @@ fn a_mesh_rotating_with_its_rim_turns_the_body_rigidly() {
         &rim,
         [true, true],
     );
-    let law = HenckyElastic::new(1e3, 0.3).unwrap();
-    let mut solver: ImplicitSolver<
-        2,
-        LinearSimplex,
-        PreviouslyConverged,
-        _,
-        NoLocking,
-        NoUpdate,
-        _,
-    > = ImplicitSolver::new(
-        LinearSimplex,
-        mesh,
-        law,
-        NoLocking,
-        NoUpdate,
-        constraints,
-        NewtonOptions::default(),
-    );
+    let mut solver = elastic_solver(mesh, constraints);
     let steps = 9;
     for s in 0..steps {
         let (l0, l1) = (s as f64 / steps as f64, (s + 1) as f64 / steps as f64);
@@ -121,24 +121,7 @@ fn a_mesh_translated_at_its_rim_keeps_the_strained_body_inside() {
     let mut fixed = constraints;
     fixed.inner.fix(inner.iter().copied(), 0);
     fixed.inner.fix(inner.iter().copied(), 1);
-    let law = HenckyElastic::new(1e3, 0.3).unwrap();
-    let mut solver: ImplicitSolver<
-        2,
-        LinearSimplex,
-        PreviouslyConverged,
-        _,
-        NoLocking,
-        NoUpdate,
-        _,
-    > = ImplicitSolver::new(
-        LinearSimplex,
-        mesh,
-        law,
-        NoLocking,
-        NoUpdate,
-        fixed,
-        NewtonOptions::default(),
-    );
+    let mut solver = elastic_solver(mesh, fixed);
     let summary = solver
         .run(&mut pts, &LoadStepping::uniform(4), |_, report, _| {
             assert!(*report.residuals.last().unwrap() <= 1e-9);

@@ -93,21 +93,14 @@ fn grid_cell_nodes<const D: usize>(grid: &RegularGrid<D>, cell: usize) -> Vec<us
         .collect()
 }
 
-impl CellMesh<2> for RegularGrid<2> {
-    const CELL: CellType = CellType::Quad;
-    fn vtk_nodes(&self) -> Vec<[f64; 3]> {
-        grid_nodes(self)
-    }
-    fn cells_holding(&self, points: &[[f64; 3]]) -> Vec<usize> {
-        connectivity(grid_cells(self, points), |c| grid_cell_nodes(self, c))
-    }
-    fn set_nodes(&mut self, nodes: &[[f64; 3]]) -> Result<(), String> {
-        set_grid_nodes(self, nodes)
-    }
-}
-
-impl CellMesh<3> for RegularGrid<3> {
-    const CELL: CellType = CellType::Hexahedron;
+impl<const D: usize> CellMesh<D> for RegularGrid<D> {
+    /// Quadrilaterals in 2D, hexahedra in 3D (other dimensions do not
+    /// compile).
+    const CELL: CellType = match D {
+        2 => CellType::Quad,
+        3 => CellType::Hexahedron,
+        _ => panic!("VTK output is for 2D and 3D grids"),
+    };
     fn vtk_nodes(&self) -> Vec<[f64; 3]> {
         grid_nodes(self)
     }
@@ -140,21 +133,13 @@ fn set_simplex_nodes<const D: usize>(
         .map_err(|e| e.to_string())
 }
 
-impl CellMesh<2> for SimplexMesh<2> {
-    const CELL: CellType = CellType::Triangle;
-    fn vtk_nodes(&self) -> Vec<[f64; 3]> {
-        self.nodes().iter().map(pad).collect()
-    }
-    fn cells_holding(&self, points: &[[f64; 3]]) -> Vec<usize> {
-        simplex_cells(self, points)
-    }
-    fn set_nodes(&mut self, nodes: &[[f64; 3]]) -> Result<(), String> {
-        set_simplex_nodes(self, nodes)
-    }
-}
-
-impl CellMesh<3> for SimplexMesh<3> {
-    const CELL: CellType = CellType::Tetra;
+impl<const D: usize> CellMesh<D> for SimplexMesh<D> {
+    /// Triangles in 2D, tetrahedra in 3D (other dimensions do not compile).
+    const CELL: CellType = match D {
+        2 => CellType::Triangle,
+        3 => CellType::Tetra,
+        _ => panic!("VTK output is for 2D and 3D meshes"),
+    };
     fn vtk_nodes(&self) -> Vec<[f64; 3]> {
         self.nodes().iter().map(pad).collect()
     }

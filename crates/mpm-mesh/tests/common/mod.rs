@@ -37,20 +37,8 @@ pub fn gmsh_patches<const D: usize>(name: &str) -> PatchMesh<D> {
     }
 }
 
-/// A deterministic pseudo-random sequence in [0, 1) (SplitMix64).
-pub struct Random(pub u64);
-
-impl Random {
-    /// The next number in [0, 1).
-    pub fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+/// The deterministic pseudo-random source of the tests.
+pub use mpm_mesh::SplitMix64 as Random;
 
 /// A structured box mesh of [0, 1] x [0, 0.75] (x [0, 1.25]) with the
 /// given cells, pattern and grading.
@@ -92,7 +80,7 @@ pub fn jittered<const D: usize>(mesh: &SimplexMesh<D>, fraction: f64, seed: u64)
             if fixed {
                 *x
             } else {
-                x + SVector::<f64, D>::from_fn(|_, _| fraction * h * (2.0 * random.next() - 1.0))
+                x + SVector::<f64, D>::from_fn(|_, _| fraction * h * random.symmetric())
             }
         })
         .collect();
@@ -198,7 +186,7 @@ pub fn pick_point<const D: usize>(
 /// Nodal values of a random field.
 pub fn nodal_field(node_count: usize, seed: u64) -> Vec<f64> {
     let mut random = Random(seed);
-    (0..node_count).map(|_| 2.0 * random.next() - 1.0).collect()
+    (0..node_count).map(|_| random.symmetric()).collect()
 }
 
 /// $\sum_k \lambda_k f_k$ over the located element.
