@@ -5,7 +5,7 @@ use std::time::Instant;
 use mpm_constitutive::{LogStrainLaw, VonMisesHistory};
 use mpm_solver::{
     BodyForcePath, Constraints, DomainUpdater, Flat, Formulation, ImplicitSolver, LoadStepping,
-    MaterialPoints, MovableMesh, NewtonOptions, NoLocking, NodalMesh, RunState, RunSummary,
+    MaterialPoints, MovableMesh, NewtonOptions, NoLocking, NodalMesh, Parts, RunState, RunSummary,
     SolverError, StepReport,
 };
 use nalgebra::SVector;
@@ -256,7 +256,7 @@ where
     }
     points.point_force = setup.loads.point_forces.clone();
     points.body_force_path = setup.loads.body_force_path.clone();
-    let mut solver: ImplicitSolver<D, B, F, L, NoLocking, U, C> = ImplicitSolver::new(
+    let mut solver: ImplicitSolver<D, Parts<B, F, L, NoLocking, U, C>> = ImplicitSolver::new(
         basis,
         setup.grid,
         setup.law,

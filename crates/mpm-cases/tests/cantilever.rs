@@ -8,7 +8,7 @@ use mpm_cases::run::RunControl;
 use mpm_cases::variant::{FormulationKind, Variant};
 use mpm_constitutive::HenckyElastic;
 use mpm_solver::{
-    ImplicitSolver, MaterialPoints, NewtonOptions, NoLocking, NoUpdate, PreviouslyConverged,
+    ImplicitSolver, MaterialPoints, NewtonOptions, NoLocking, NoUpdate, Parts, PreviouslyConverged,
     UpdatedLagrangian,
 };
 use nalgebra::SVector;
@@ -109,17 +109,19 @@ fn the_pc_solution_satisfies_ul_equilibrium_at_every_step() {
     let force = SVector::<f64, 2>::new(0.0, -p.load / 2.0);
     points.point_force = vec![(loaded[0], force), (loaded[1], force)];
     let options = NewtonOptions::default();
-    let mut pc: ImplicitSolver<2, LinearMpm, PreviouslyConverged, _, NoLocking, NoUpdate, _> =
-        ImplicitSolver::new(
-            LinearMpm,
-            grid.clone(),
-            law,
-            NoLocking,
-            NoUpdate,
-            constraints.clone(),
-            options,
-        );
-    let mut ul: ImplicitSolver<2, LinearMpm, UpdatedLagrangian, _, NoLocking, NoUpdate, _> =
+    let mut pc: ImplicitSolver<
+        2,
+        Parts<LinearMpm, PreviouslyConverged, _, NoLocking, NoUpdate, _>,
+    > = ImplicitSolver::new(
+        LinearMpm,
+        grid.clone(),
+        law,
+        NoLocking,
+        NoUpdate,
+        constraints.clone(),
+        options,
+    );
+    let mut ul: ImplicitSolver<2, Parts<LinearMpm, UpdatedLagrangian, _, NoLocking, NoUpdate, _>> =
         ImplicitSolver::new(
             LinearMpm,
             grid,

@@ -16,12 +16,12 @@ use mpm_constitutive::HenckyElastic;
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
     ConvectedCorners, DomainUpdater, Formulation, ImplicitSolver, MaterialPoints, NewtonOptions,
-    NoLocking, NoUpdate, NodalConstraints, PreviouslyConverged, UpdatedLagrangian,
+    NoLocking, NoUpdate, NodalConstraints, Parts, PreviouslyConverged, UpdatedLagrangian,
 };
 use nalgebra::SVector;
 
 type Solver<const D: usize, B, F, U> =
-    ImplicitSolver<D, B, F, HenckyElastic, NoLocking, U, NodalConstraints<D>>;
+    ImplicitSolver<D, Parts<B, F, HenckyElastic, NoLocking, U, NodalConstraints<D>>>;
 
 /// A solver with a prepared step, its points and a free-dof increment.
 type Prepared<const D: usize, B, F, U> = (

@@ -3,6 +3,7 @@
 
 use nalgebra::SVector;
 
+use crate::error::MeshMotionError;
 use crate::mesh::MovableMesh;
 
 /// Prescribed displacement increments of grid degrees of freedom.
@@ -28,7 +29,11 @@ pub trait Constraints<const D: usize>: Send + Sync {
     ///
     /// # Errors
     /// A message when the mesh cannot take that position.
-    fn move_mesh<M: MovableMesh<D>>(&mut self, _mesh: &mut M, _lambda: f64) -> Result<(), String> {
+    fn move_mesh<M: MovableMesh<D>>(
+        &mut self,
+        _mesh: &mut M,
+        _lambda: f64,
+    ) -> Result<(), MeshMotionError> {
         Ok(())
     }
 }

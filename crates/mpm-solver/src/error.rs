@@ -1,7 +1,14 @@
 //! The crate's error type.
 
+use std::sync::Arc;
+
+use mpm_basis::BasisError;
 use mpm_constitutive::ConstitutiveError;
+use mpm_mesh::MeshError;
 use thiserror::Error;
+
+use crate::domain::DomainError;
+use crate::linear::LinearSolveError;
 
 /// Why a Newton–Raphson load step failed. A failed step is retried with
 /// half the load increment; [`SolverError::StepTooSmall`] carries the last
@@ -52,10 +59,11 @@ pub enum StepFailure {
         limit: f64,
     },
     /// The linear solver failed (singular or non-finite system).
-    #[error("linear solve failed: {reason}")]
+    #[error("linear solve failed: {source}")]
     LinearSolve {
         /// What went wrong.
-        reason: String,
+        #[from]
+        source: LinearSolveError,
     },
 }
 
@@ -92,7 +100,8 @@ pub enum SolverError {
         /// Its position.
         position: Vec<f64>,
         /// The basis error.
-        reason: String,
+        #[source]
+        reason: BasisFailure,
     },
     /// The observer asked the run to stop after a converged step (e.g. a
     /// step budget); the state after that step is complete and a
@@ -113,6 +122,103 @@ pub enum SolverError {
         /// Index of the material point.
         point: usize,
         /// What went wrong.
-        reason: String,
+        #[source]
+        reason: DomainError,
     },
+    /// The background mesh could not take its position at a load factor
+    /// (moving-mesh conditions).
+    #[error("moving the mesh to load factor {load_factor}: {source}")]
+    MeshMotion {
+        /// The load factor.
+        load_factor: f64,
+        /// Why.
+        source: MeshMotionError,
+    },
+    /// A mesh could not be built or read.
+    #[error("mesh: {0}")]
+    Mesh(#[from] MeshError),
+    /// A material could not be built (invalid parameters).
+    #[error("material: {0}")]
+    Material(#[from] ConstitutiveError),
+    /// The sparsity pattern of a step could not be analysed by the linear
+    /// solver.
+    #[error("analysing the stiffness pattern of the step: {0}")]
+    Pattern(#[source] LinearSolveError),
+    /// The observer of a run (output, progress) failed; the state after the
+    /// last converged step is intact.
+    #[error("after a converged step: {0}")]
+    Observer(#[source] ObserverError),
+}
+
+/// What went wrong evaluating a material point's basis.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum BasisFailure {
+    /// The basis itself failed (point or domain outside the mesh).
+    #[error(transparent)]
+    Basis(#[from] BasisError),
+    /// The basis returned more nodes than it declared or a node outside
+    /// the mesh (a bug of the basis).
+    #[error("the basis returned {nodes} nodes (at most {max}) or a node outside the mesh")]
+    Stencil {
+        /// Nodes returned.
+        nodes: usize,
+        /// `BasisFunction::MAX_NODES`.
+        max: usize,
+    },
+}
+
+/// Why a background mesh could not take a position.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MeshMotionError {
+    /// The positions do not match the mesh.
+    #[error("{got} positions for a mesh of {expected} nodes")]
+    NodeCount {
+        /// Positions given.
+        got: usize,
+        /// Nodes of the mesh.
+        expected: usize,
+    },
+    /// A regular grid may only stretch and translate along its axes.
+    #[error(
+        "moving node {node} to {position:?} would make the grid irregular; regular grids only stretch and translate along their axes"
+    )]
+    Irregular {
+        /// The node.
+        node: usize,
+        /// The position asked for.
+        position: Vec<f64>,
+    },
+    /// The moved mesh is not admissible (an inverted simplex).
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+}
+
+/// An error of a run's observer (e.g. writing output), kept with its
+/// source. Two are equal when they are the same error or say the same.
+#[derive(Debug, Clone)]
+pub struct ObserverError(pub Arc<dyn std::error::Error + Send + Sync>);
+
+impl ObserverError {
+    /// Wraps `e`.
+    pub fn new(e: impl std::error::Error + Send + Sync + 'static) -> Self {
+        Self(Arc::new(e))
+    }
+}
+
+impl std::fmt::Display for ObserverError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for ObserverError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(&*self.0)
+    }
+}
+
+impl PartialEq for ObserverError {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0) || self.0.to_string() == other.0.to_string()
+    }
 }

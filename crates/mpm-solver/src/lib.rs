@@ -19,23 +19,27 @@ pub mod linear;
 pub mod locking;
 pub mod mesh;
 pub mod moving_mesh;
+pub mod parts;
 pub mod points;
+pub mod stages;
 pub mod stepping;
-pub mod system;
 
 pub use boundary::{Constraints, NodalConstraints, StepView};
 pub use checkpoint::Flat;
 pub use domain::{
-    ConvectedCorners, CornerMidpoint, DetF, DiagF, DomainContext, DomainError, DomainUpdater,
-    DomainVolume, IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, StretchU,
-    VolumeCorrectedDiagF,
+    ConvectedCorners, CornerMidpoint, DeformationRule, DetF, DiagF, DomainContext, DomainError,
+    DomainUpdater, DomainVolume, GimpContext, IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate,
+    StretchU, VolumeCorrectedDiagF,
 };
-pub use error::{SolverError, StepFailure};
+pub use error::{BasisFailure, MeshMotionError, ObserverError, SolverError, StepFailure};
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
-pub use implicit::{FreeStiffness, ImplicitSolver, NewtonOptions, StepError, StepReport};
-pub use linear::{Factorisation, LinearSolver};
+pub use implicit::{
+    FreeStiffness, ImplicitBuilder, ImplicitSolver, NewtonOptions, StepError, StepReport,
+};
+pub use linear::{Factorisation, FaerDirect, LinearSolveError, LinearSolver};
 pub use locking::{LockingTreatment, NoLocking};
 pub use mesh::{MovableMesh, NodalMesh};
 pub use moving_mesh::{MeshMotion, MovingMesh, Rotation, Stretch, Translation};
+pub use parts::{Parts, PointsOf, SolverParts};
 pub use points::{BodyForcePath, MaterialPoints};
 pub use stepping::{LoadStepping, RunState, RunSummary, StepContext};

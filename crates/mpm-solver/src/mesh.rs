@@ -7,6 +7,8 @@
 
 use mpm_basis::{BasisError, BasisFunction, LinearSimplex, Stencil};
 use mpm_mesh::{MeshError, RegularGrid, SimplexMesh};
+
+use crate::error::MeshMotionError;
 use nalgebra::SVector;
 
 /// A background mesh with numbered nodes and linear shape functions.
@@ -98,7 +100,7 @@ pub trait MovableMesh<const D: usize>: NodalMesh<D> {
     /// # Errors
     /// A message when the moved mesh is not admissible: an inverted
     /// simplex, or a regular grid that would stop being regular.
-    fn move_nodes(&mut self, positions: Vec<SVector<f64, D>>) -> Result<(), String>;
+    fn move_nodes(&mut self, positions: Vec<SVector<f64, D>>) -> Result<(), MeshMotionError>;
 }
 
 impl<const D: usize> MovableMesh<D> for SimplexMesh<D> {
@@ -107,8 +109,8 @@ impl<const D: usize> MovableMesh<D> for SimplexMesh<D> {
         self.nodes()[node]
     }
 
-    fn move_nodes(&mut self, positions: Vec<SVector<f64, D>>) -> Result<(), String> {
-        SimplexMesh::move_nodes(self, positions).map_err(|e| e.to_string())
+    fn move_nodes(&mut self, positions: Vec<SVector<f64, D>>) -> Result<(), MeshMotionError> {
+        Ok(SimplexMesh::move_nodes(self, positions)?)
     }
 }
 
@@ -121,27 +123,26 @@ impl<const D: usize> MovableMesh<D> for RegularGrid<D> {
     /// Accepts only motions that keep the grid regular: an axis-aligned
     /// affine map (translation and per-axis stretch), checked at every
     /// node to a relative 1e-12.
-    fn move_nodes(&mut self, positions: Vec<SVector<f64, D>>) -> Result<(), String> {
+    fn move_nodes(&mut self, positions: Vec<SVector<f64, D>>) -> Result<(), MeshMotionError> {
         if positions.len() != self.node_count() {
-            return Err(format!(
-                "{} positions for a grid of {} nodes",
-                positions.len(),
-                self.node_count()
-            ));
+            return Err(MeshMotionError::NodeCount {
+                got: positions.len(),
+                expected: self.node_count(),
+            });
         }
         let last = self.node_count() - 1;
         let (lo, hi) = (positions[0], positions[last]);
         let cells = self.cells_per_axis();
         let spacing = SVector::<f64, D>::from_fn(|i, _| (hi[i] - lo[i]) / cells[i] as f64);
-        let moved = RegularGrid::new(lo, spacing, cells).map_err(|e| e.to_string())?;
+        let moved = RegularGrid::new(lo, spacing, cells)?;
         let scale = (hi - lo).norm();
         for (n, x) in positions.iter().enumerate() {
-            let expected = RegularGrid::node_position(&moved, n).map_err(|e| e.to_string())?;
+            let expected = RegularGrid::node_position(&moved, n)?;
             if (expected - x).norm() > 1e-12 * scale {
-                return Err(format!(
-                    "moving node {n} to {:?} would make the grid irregular; regular grids only stretch and translate along their axes",
-                    x.as_slice()
-                ));
+                return Err(MeshMotionError::Irregular {
+                    node: n,
+                    position: x.as_slice().to_vec(),
+                });
             }
         }
         *self = moved;

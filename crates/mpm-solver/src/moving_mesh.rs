@@ -16,6 +16,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::boundary::{Constraints, StepView};
+use crate::error::MeshMotionError;
 use crate::mesh::MovableMesh;
 
 /// Node positions as a function of the load factor.
@@ -242,16 +243,15 @@ impl<const D: usize, C: Constraints<D>, M: MeshMotion<D>> Constraints<D> for Mov
         &mut self,
         mesh: &mut Mesh,
         lambda: f64,
-    ) -> Result<(), String> {
+    ) -> Result<(), MeshMotionError> {
         if self.at == Some(lambda) {
             return Ok(());
         }
         if self.initial.len() != mesh.node_count() {
-            return Err(format!(
-                "the moving mesh was set up for {} nodes, the mesh has {}",
-                self.initial.len(),
-                mesh.node_count()
-            ));
+            return Err(MeshMotionError::NodeCount {
+                got: self.initial.len(),
+                expected: mesh.node_count(),
+            });
         }
         mesh.move_nodes(self.positions(lambda))?;
         self.at = Some(lambda);

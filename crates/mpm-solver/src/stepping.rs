@@ -3,17 +3,9 @@
 //! after a failed one; below a minimum the analysis stops with a typed
 //! error naming the step, the last residual and the cause.
 
-use mpm_basis::BasisFunction;
-use mpm_constitutive::LogStrainLaw;
-
-use crate::boundary::Constraints;
-use crate::domain::DomainUpdater;
 use crate::error::SolverError;
-use crate::formulation::Formulation;
 use crate::implicit::{FreeStiffness, ImplicitSolver, StepError, StepReport};
-use crate::locking::LockingTreatment;
-use crate::mesh::MovableMesh;
-use crate::points::MaterialPoints;
+use crate::parts::{PointsOf, SolverParts};
 
 /// Load-factor increments: the analysis takes the load factor from 0 to 1.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -90,31 +82,18 @@ pub struct RunSummary {
     pub iterations: usize,
 }
 
-impl<const D: usize, B, F, L, K, U, C> ImplicitSolver<D, B, F, L, K, U, C>
-where
-    B: BasisFunction<D>,
-    B::Mesh: MovableMesh<D>,
-    F: Formulation,
-    L: LogStrainLaw,
-    K: LockingTreatment,
-    U: DomainUpdater<D, B::Domain>,
-    C: Constraints<D>,
-{
+impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// Runs the analysis from load factor 0 to 1, calling `observer` after
     /// every converged step (for output and progress; an error from it
     /// stops the run).
     pub fn run<O>(
         &mut self,
-        points: &mut MaterialPoints<D, L::History, B::Domain>,
+        points: &mut PointsOf<D, P>,
         stepping: &LoadStepping,
         mut observer: O,
     ) -> Result<RunSummary, SolverError>
     where
-        O: FnMut(
-            usize,
-            &StepReport<D>,
-            &MaterialPoints<D, L::History, B::Domain>,
-        ) -> Result<(), SolverError>,
+        O: FnMut(usize, &StepReport<D>, &PointsOf<D, P>) -> Result<(), SolverError>,
     {
         self.run_from(points, stepping, RunState::start(stepping), |s, r, p, _| {
             observer(s, r, p)
@@ -126,7 +105,7 @@ where
     /// after the step, from which the run can later be resumed.
     pub fn run_from<O>(
         &mut self,
-        points: &mut MaterialPoints<D, L::History, B::Domain>,
+        points: &mut PointsOf<D, P>,
         stepping: &LoadStepping,
         state: RunState,
         mut observer: O,
@@ -135,8 +114,8 @@ where
         O: FnMut(
             usize,
             &StepReport<D>,
-            &MaterialPoints<D, L::History, B::Domain>,
-            &StepContext<'_, B::Mesh>,
+            &PointsOf<D, P>,
+            &StepContext<'_, P::Mesh>,
         ) -> Result<(), SolverError>,
     {
         if !(stepping.min > 0.0

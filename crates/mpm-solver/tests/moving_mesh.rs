@@ -10,7 +10,7 @@ use mpm_constitutive::HenckyElastic;
 use mpm_mesh::{AnnulusMesh, SimplexMesh};
 use mpm_solver::{
     Constraints, ImplicitSolver, LoadStepping, MaterialPoints, MovingMesh, NewtonOptions,
-    NoLocking, NoUpdate, NodalConstraints, PreviouslyConverged, Rotation, Translation,
+    NoLocking, NoUpdate, NodalConstraints, Parts, PreviouslyConverged, Rotation, Translation,
 };
 use nalgebra::{Matrix3, Vector2};
 
@@ -19,7 +19,10 @@ use nalgebra::{Matrix3, Vector2};
 fn elastic_solver<C: Constraints<2>>(
     mesh: SimplexMesh<2>,
     constraints: C,
-) -> ImplicitSolver<2, LinearSimplex, PreviouslyConverged, HenckyElastic, NoLocking, NoUpdate, C> {
+) -> ImplicitSolver<
+    2,
+    Parts<LinearSimplex, PreviouslyConverged, HenckyElastic, NoLocking, NoUpdate, C>,
+> {
     ImplicitSolver::new(
         LinearSimplex,
         mesh,

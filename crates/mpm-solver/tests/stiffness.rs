@@ -8,7 +8,7 @@ use mpm_constitutive::{HenckyElastic, LogStrainLaw, VonMises};
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
     Formulation, ImplicitSolver, MaterialPoints, NewtonOptions, NoLocking, NoUpdate,
-    NodalConstraints, PreviouslyConverged, UpdatedLagrangian,
+    NodalConstraints, Parts, PreviouslyConverged, UpdatedLagrangian,
 };
 use nalgebra::SVector;
 
@@ -60,7 +60,7 @@ where
         weak_node_threshold: 0.0,
         ..NewtonOptions::default()
     };
-    let mut solver: ImplicitSolver<D, B, F, L, NoLocking, NoUpdate, _> =
+    let mut solver: ImplicitSolver<D, Parts<B, F, L, NoLocking, NoUpdate, _>> =
         ImplicitSolver::new(basis, grid, law, NoLocking, NoUpdate, constraints, options);
     let n = solver.prepare_step(&points, 0.0, 1.0).unwrap();
     let du: Vec<f64> = (0..n).map(|k| 0.02 * ((k * 31 + 7) as f64).sin()).collect();

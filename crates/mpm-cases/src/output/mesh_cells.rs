@@ -63,7 +63,7 @@ fn set_grid_nodes<const D: usize>(
     grid: &mut RegularGrid<D>,
     nodes: &[[f64; 3]],
 ) -> Result<(), String> {
-    MovableMesh::move_nodes(grid, nodes.iter().map(unpad).collect())
+    MovableMesh::move_nodes(grid, nodes.iter().map(unpad).collect()).map_err(|e| e.to_string())
 }
 
 /// The node ids of cell `cell` in VTK order: counter-clockwise in 2D;

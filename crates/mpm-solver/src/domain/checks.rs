@@ -9,20 +9,18 @@ use super::DomainError;
 
 /// $\det F$ of a deformation gradient (`name` says which: `"F"` or
 /// `"ΔF"`), checked to be finite and positive.
-pub(super) fn jacobian(f: &Matrix3<f64>, name: &str) -> Result<f64, DomainError> {
+pub(super) fn jacobian(f: &Matrix3<f64>, name: &'static str) -> Result<f64, DomainError> {
     if let Some(k) = f.iter().position(|x| !x.is_finite()) {
-        return Err(DomainError(format!(
-            "{name}[({}, {})] = {} is not finite",
-            k % 3,
-            k / 3,
-            f[k]
-        )));
+        return Err(DomainError::NonFiniteTensor {
+            name,
+            row: k % 3,
+            col: k / 3,
+            value: f[k],
+        });
     }
     let j = f.determinant();
     if !j.is_finite() || j <= 0.0 {
-        return Err(DomainError(format!(
-            "det {name} = {j:e} is not positive: the deformation is inverted or degenerate"
-        )));
+        return Err(DomainError::NonPositiveJacobian { name, det: j });
     }
     Ok(j)
 }
@@ -31,13 +29,14 @@ pub(super) fn jacobian(f: &Matrix3<f64>, name: &str) -> Result<f64, DomainError>
 /// are finite and non-negative.
 pub(super) fn half_lengths<const D: usize>(
     l: &SVector<f64, D>,
-    which: &str,
+    which: &'static str,
 ) -> Result<(), DomainError> {
     match l.iter().position(|x| !x.is_finite() || *x < 0.0) {
-        Some(i) => Err(DomainError(format!(
-            "the {which} half-length {} along axis {i} is not a finite non-negative number",
-            l[i]
-        ))),
+        Some(axis) => Err(DomainError::HalfLength {
+            which,
+            axis,
+            value: l[axis],
+        }),
         None => Ok(()),
     }
 }
@@ -119,11 +118,11 @@ mod tests {
         let mut f = Matrix3::identity();
         f[(1, 0)] = f64::NAN;
         let e = jacobian(&f, "F").expect_err("NaN entry");
-        assert!(e.0.contains("F[(1, 0)]"), "{e}");
+        assert!(e.to_string().contains("F[(1, 0)]"), "{e}");
         let reflect = Matrix3::from_diagonal(&nalgebra::Vector3::new(-1.0, 1.0, 1.0));
         let e = jacobian(&reflect, "ΔF").expect_err("det < 0");
         assert!(
-            e.0.contains("det ΔF") && e.0.contains("not positive"),
+            e.to_string().contains("det ΔF") && e.to_string().contains("not positive"),
             "{e}"
         );
         let flat = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 0.0, 1.0));
@@ -143,7 +142,10 @@ mod tests {
     fn half_lengths_must_be_finite_and_non_negative() {
         assert!(half_lengths(&Vector2::new(0.0, 0.5), "initial").is_ok());
         let e = half_lengths(&Vector2::new(0.5, -1e-3), "previous").expect_err("negative");
-        assert!(e.0.contains("previous") && e.0.contains("axis 1"), "{e}");
+        assert!(
+            e.to_string().contains("previous") && e.to_string().contains("axis 1"),
+            "{e}"
+        );
         assert!(half_lengths(&Vector2::new(f64::INFINITY, 0.5), "initial").is_err());
     }
 }

@@ -27,8 +27,108 @@ pub use volume_corrected_diag_f::VolumeCorrectedDiagF;
 
 /// Why a domain update failed (the solver adds the material point).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct DomainError(pub String);
+#[non_exhaustive]
+pub enum DomainError {
+    /// A deformation gradient has a non-finite entry.
+    #[error("{name}[({row}, {col})] = {value} is not finite")]
+    NonFiniteTensor {
+        /// `"F"` or `"ΔF"`.
+        name: &'static str,
+        /// Row of the entry.
+        row: usize,
+        /// Column of the entry.
+        col: usize,
+        /// The entry.
+        value: f64,
+    },
+    /// A deformation gradient is inverted or degenerate.
+    #[error("det {name} = {det:e} is not positive: the deformation is inverted or degenerate")]
+    NonPositiveJacobian {
+        /// `"F"` or `"ΔF"`.
+        name: &'static str,
+        /// Its determinant.
+        det: f64,
+    },
+    /// A half-length is negative or not finite.
+    #[error(
+        "the {which} half-length {value} along axis {axis} is not a finite non-negative number"
+    )]
+    HalfLength {
+        /// `"initial"` or `"previous"`.
+        which: &'static str,
+        /// The axis.
+        axis: usize,
+        /// The value.
+        value: f64,
+    },
+    /// The right stretch tensor of eq. (34) could not be computed.
+    #[error("the right stretch tensor of F could not be computed")]
+    StretchTensor,
+    /// The grid displacement interpolated at a corner or mid-point is not
+    /// finite.
+    #[error("the displacement {value:?} at {at:?} is not finite")]
+    NonFiniteDisplacement {
+        /// The displacement.
+        value: Vec<f64>,
+        /// Where.
+        at: Vec<f64>,
+    },
+    /// The background mesh's shape functions could not be evaluated at a
+    /// corner or mid-point (it left the mesh).
+    #[error("the mesh's shape functions at {at:?}: {source}")]
+    Mesh {
+        /// Where.
+        at: Vec<f64>,
+        /// The basis error.
+        source: mpm_basis::BasisError,
+    },
+    /// A corner or mid-point lies on a node that is not active this step.
+    #[error("node {node} near {at:?} is not active")]
+    InactiveNode {
+        /// The mesh node.
+        node: usize,
+        /// The point.
+        at: Vec<f64>,
+    },
+    /// The convected CPDI2 domain is inverted or degenerate.
+    #[error("the convected CPDI2 domain is not admissible: {0}")]
+    Corners(#[source] mpm_basis::BasisError),
+    /// The rule cannot produce an admissible domain from this deformation.
+    #[error("{rule}: {reason}")]
+    Inadmissible {
+        /// The rule's [`DomainUpdater::NAME`].
+        rule: &'static str,
+        /// Why, and what to do instead.
+        reason: String,
+    },
+}
+
+/// The [`DomainContext`] of a GIMP point, whose domain is its vector of
+/// half-lengths.
+pub type GimpContext<'a, const D: usize> = DomainContext<'a, D, SVector<f64, D>>;
+
+/// A GIMP rule whose half-lengths follow from the point's own deformation
+/// (eqs. 32–34, 38, 39): it never reads the grid displacement. Such a rule
+/// implements this trait only; [`DomainUpdater`] comes with it.
+pub trait DeformationRule<const D: usize>: Send + Sync {
+    /// Name used in outputs and scene files.
+    const NAME: &'static str;
+
+    /// The half-lengths after the converged step.
+    fn half_lengths(&self, ctx: &GimpContext<'_, D>) -> Result<SVector<f64, D>, DomainError>;
+}
+
+impl<const D: usize, R: DeformationRule<D>> DomainUpdater<D, SVector<f64, D>> for R {
+    const NAME: &'static str = R::NAME;
+
+    #[inline]
+    fn update<U>(&self, ctx: &GimpContext<'_, D>, _: U) -> Result<SVector<f64, D>, DomainError>
+    where
+        U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
+    {
+        self.half_lengths(ctx)
+    }
+}
 
 /// What a domain update may read about one material point after a
 /// converged load step.

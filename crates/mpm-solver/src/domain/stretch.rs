@@ -2,7 +2,7 @@
 
 use nalgebra::SVector;
 
-use super::{DomainContext, DomainError, DomainUpdater, right_stretch};
+use super::{DeformationRule, DomainError, GimpContext, right_stretch};
 
 /// GIMP half-lengths scaled by the diagonal of the right stretch tensor,
 /// $l^p_i = l^{p0}_i U_{ii}$ (Charlton et al. 2017; Coombs 2020 eq. 34),
@@ -12,20 +12,11 @@ use super::{DomainContext, DomainError, DomainUpdater, right_stretch};
 #[derive(Debug, Clone, Copy, Default)]
 pub struct StretchU;
 
-impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for StretchU {
+impl<const D: usize> DeformationRule<D> for StretchU {
     const NAME: &'static str = "stretch";
 
-    fn update<U>(
-        &self,
-        ctx: &DomainContext<'_, D, SVector<f64, D>>,
-        _displacement_at: U,
-    ) -> Result<SVector<f64, D>, DomainError>
-    where
-        U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
-    {
-        let u = right_stretch(ctx.f).ok_or_else(|| {
-            DomainError("the right stretch tensor of F could not be computed".into())
-        })?;
+    fn half_lengths(&self, ctx: &GimpContext<'_, D>) -> Result<SVector<f64, D>, DomainError> {
+        let u = right_stretch(ctx.f).ok_or(DomainError::StretchTensor)?;
         Ok(SVector::<f64, D>::from_fn(|i, _| {
             ctx.initial[i] * u[(i, i)]
         }))
@@ -36,6 +27,8 @@ impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for StretchU {
 mod tests {
     use super::*;
     use crate::domain::NoUpdate;
+    #[allow(unused_imports)]
+    use crate::domain::{DomainContext, DomainUpdater};
     use nalgebra::Matrix3;
     use nalgebra::{Rotation3, Vector2};
 

@@ -2,7 +2,7 @@
 
 use nalgebra::{Matrix3, SVector};
 
-use super::{DomainContext, DomainError, DomainUpdater, checks};
+use super::{DeformationRule, DomainError, GimpContext, checks};
 
 /// GIMP half-lengths scaled by the diagonal of $F$ and corrected to the
 /// volume change (Coombs et al. 2020 eq. 38, no sum on $i$):
@@ -47,17 +47,10 @@ impl VolumeCorrectedDiagF {
     pub const MIN_RELATIVE_DIAGONAL: f64 = 1.490_116_119_384_765_6e-8;
 }
 
-impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for VolumeCorrectedDiagF {
+impl<const D: usize> DeformationRule<D> for VolumeCorrectedDiagF {
     const NAME: &'static str = "volume_corrected_diag_f";
 
-    fn update<U>(
-        &self,
-        ctx: &DomainContext<'_, D, SVector<f64, D>>,
-        _displacement_at: U,
-    ) -> Result<SVector<f64, D>, DomainError>
-    where
-        U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
-    {
+    fn half_lengths(&self, ctx: &GimpContext<'_, D>) -> Result<SVector<f64, D>, DomainError> {
         checks::half_lengths(ctx.initial, "initial")?;
         volume_corrected_diagonal(ctx.initial, ctx.f, "F")
     }
@@ -69,7 +62,7 @@ impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for VolumeCorrectedDiagF 
 pub(super) fn volume_corrected_diagonal<const D: usize>(
     l: &SVector<f64, D>,
     g: &Matrix3<f64>,
-    name: &str,
+    name: &'static str,
 ) -> Result<SVector<f64, D>, DomainError> {
     let j = checks::jacobian(g, name)?;
     let floor = VolumeCorrectedDiagF::MIN_RELATIVE_DIAGONAL * g.norm();
@@ -77,13 +70,16 @@ pub(super) fn volume_corrected_diagonal<const D: usize>(
     for i in 0..D {
         let gii = g[(i, i)].abs();
         if gii <= floor {
-            return Err(DomainError(format!(
-                "the diagonal component {name}[({i}, {i})] = {:e} is zero (|{name}_ii| <= \
+            return Err(DomainError::Inadmissible {
+                rule: "volume_corrected_diag_f",
+                reason: format!(
+                    "the diagonal component {name}[({i}, {i})] = {:e} is zero (|{name}_ii| <= \
                  sqrt(eps)*|{name}| = {floor:e}), as under a rotation by 90°: the \
                  volume-corrected diagonal rule divides by the product of the diagonal; \
                  rotate in smaller steps (eq. 39) or use the midpoint rule (eq. 37)",
-                g[(i, i)]
-            )));
+                    g[(i, i)]
+                ),
+            });
         }
         product *= gii;
     }
@@ -95,6 +91,8 @@ pub(super) fn volume_corrected_diagonal<const D: usize>(
 mod tests {
     use super::*;
     use crate::domain::checks::Fixture;
+    #[allow(unused_imports)]
+    use crate::domain::{DomainContext, DomainUpdater};
     use nalgebra::{Rotation3, Vector2, Vector3};
 
     #[test]
@@ -142,7 +140,10 @@ mod tests {
         let e = VolumeCorrectedDiagF
             .update(&p.ctx(), |_| Ok(Vector2::zeros()))
             .expect_err("F_00 = 0");
-        assert!(e.0.contains("F[(0, 0)]") && e.0.contains("zero"), "{e}");
+        assert!(
+            e.to_string().contains("F[(0, 0)]") && e.to_string().contains("zero"),
+            "{e}"
+        );
         // Zero up to rounding (90° as three steps of 30°) is zero as well.
         let step = Rotation3::from_axis_angle(&Vector3::z_axis(), 30f64.to_radians()).into_inner();
         let p = Fixture::<2, _>::first_step(
@@ -165,6 +166,6 @@ mod tests {
         let e = VolumeCorrectedDiagF
             .update(&p.ctx(), |_| Ok(Vector2::zeros()))
             .expect_err("det < 0");
-        assert!(e.0.contains("det F"), "{e}");
+        assert!(e.to_string().contains("det F"), "{e}");
     }
 }

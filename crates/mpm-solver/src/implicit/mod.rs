@@ -1,0 +1,251 @@
+//! The generic implicit Newton–Raphson solver for quasi-static problems
+//! (Coombs et al. 2020 §6.3; the algorithm of AMPLE, Coombs & Augarde 2020).
+//!
+//! One load step, [`ImplicitSolver::solve_load_step`], is the paper's
+//! algorithm, each stage a method of [`stages`](self::stages) that calls
+//! the reusable functions of [`crate::stages`]:
+//!
+//! 1. [`evaluate_basis`](ImplicitSolver::evaluate_basis): basis values and
+//!    gradients at the start of the step, once per step;
+//! 2. [`build_system`](ImplicitSolver::build_system): active nodes, dofs,
+//!    prescribed increments, sparsity pattern, symbolic factorisation;
+//! 3. [`assemble_external_force`](ImplicitSolver::assemble_external_force):
+//!    eqs. (24), (25), (29);
+//! 4. Newton iterations: [`update_material_points`](ImplicitSolver::update_material_points)
+//!    (eq. 7, the constitutive update), [`assemble_internal_force`](ImplicitSolver::assemble_internal_force)
+//!    (eqs. 6/23, 28), the convergence test on eq. (40)
+//!    ([`NewtonMonitor`]), then
+//!    [`assemble_stiffness`](ImplicitSolver::assemble_stiffness) (eqs. 4/21, 27)
+//!    and the linear solve (eqs. 26, 30);
+//! 5. [`commit`](ImplicitSolver::commit): positions (eq. 31), deformation,
+//!    volumes, history and domains.
+//!
+//! Material-point loops run in parallel with rayon; every sum is taken in
+//! an order fixed by point and node numbering, so results do not depend on
+//! the number of threads.
+//!
+//! The folder holds one concern per file: [`options`] (Newton controls),
+//! [`report`] (what a step reports), [`builder`] (composition without
+//! spelling types), `stages` (the stage methods), `predictor` (the secant
+//! predictor and its checkpoint state) and `verification` (residual and
+//! stiffness at a chosen increment, for finite-difference tests and
+//! benchmarks).
+
+pub mod builder;
+pub mod options;
+mod predictor;
+pub mod report;
+mod stages;
+mod verification;
+
+pub use builder::ImplicitBuilder;
+pub use options::{MAX_BACKTRACKS, NewtonOptions};
+pub use report::{FreeStiffness, StepError, StepReport};
+
+use mpm_constitutive::Response;
+use mpm_constitutive::tensor::Tensor4;
+use nalgebra::{Matrix3, SVector};
+
+use crate::error::StepFailure;
+use crate::linear::{FaerDirect, LinearSolver};
+use crate::parts::{PointsOf, SolverParts};
+use crate::stages::convergence::{self, NewtonMonitor, Verdict};
+use crate::stages::system::StepSystem;
+
+/// Per-iteration buffers, sized once per step.
+#[derive(Debug)]
+struct Iterate<const D: usize, H> {
+    du: Vec<f64>,
+    f_ext: Vec<f64>,
+    f_int: Vec<f64>,
+    rhs: Vec<f64>,
+    values: Vec<f64>,
+    responses: Vec<Option<Response<H>>>,
+    stress_w: Vec<Matrix3<f64>>,
+    tangent_w: Vec<Tensor4>,
+    mapped: Vec<SVector<f64, D>>,
+    increments: Vec<Matrix3<f64>>,
+    volumes: Vec<f64>,
+    /// `values` holds a stiffness assembled on the current system.
+    stiffness_assembled: bool,
+}
+
+impl<const D: usize, H> Default for Iterate<D, H> {
+    fn default() -> Self {
+        Self {
+            du: Vec::new(),
+            f_ext: Vec::new(),
+            f_int: Vec::new(),
+            rhs: Vec::new(),
+            values: Vec::new(),
+            responses: Vec::new(),
+            stress_w: Vec::new(),
+            tangent_w: Vec::new(),
+            mapped: Vec::new(),
+            increments: Vec::new(),
+            volumes: Vec::new(),
+            stiffness_assembled: false,
+        }
+    }
+}
+
+/// The implicit quasi-static solver in dimension `D` composed of the
+/// components `P` ([`SolverParts`]: basis, formulation, law, locking
+/// treatment, domain updater, Dirichlet conditions). Every combination
+/// monomorphises; a scene pays only for the components it names. Build
+/// one with [`ImplicitBuilder`] (the types are inferred) or
+/// [`ImplicitSolver::new`].
+pub struct ImplicitSolver<const D: usize, P: SolverParts<D>> {
+    /// The basis.
+    pub basis: P::Basis,
+    /// The background mesh.
+    pub mesh: P::Mesh,
+    /// The statement of equilibrium.
+    pub formulation: P::Formulation,
+    /// The material law (one material per body).
+    pub law: P::Law,
+    /// The locking treatment.
+    pub locking: P::Locking,
+    /// The domain updater.
+    pub updater: P::Updater,
+    /// Dirichlet conditions.
+    pub constraints: P::Constraints,
+    /// Newton controls.
+    pub options: NewtonOptions,
+    linear: Box<dyn LinearSolver>,
+    /// `linear` holds the analysed pattern of the current system.
+    analysed: bool,
+    system: StepSystem<D>,
+    it: Iterate<D, P::History>,
+    /// The last converged increment per mesh dof and its load increment.
+    previous: Option<(Vec<f64>, f64)>,
+    /// Per point, the cell where its location starts (the parent cell of
+    /// the last step; walking on unstructured meshes, Wang et al. 2021
+    /// Algorithm 1); `usize::MAX` when unknown.
+    hints: Vec<usize>,
+}
+
+impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
+    /// Composes a solver with the default formulation value of
+    /// `P::Formulation` and the faer direct linear solver; see
+    /// [`ImplicitBuilder`] to choose them as values and let the types be
+    /// inferred.
+    pub fn new(
+        basis: P::Basis,
+        mesh: P::Mesh,
+        law: P::Law,
+        locking: P::Locking,
+        updater: P::Updater,
+        constraints: P::Constraints,
+        options: NewtonOptions,
+    ) -> Self {
+        Self {
+            basis,
+            mesh,
+            formulation: Default::default(),
+            law,
+            locking,
+            updater,
+            constraints,
+            options,
+            linear: Box::new(FaerDirect::default()),
+            analysed: false,
+            system: StepSystem::default(),
+            it: Iterate::default(),
+            previous: None,
+            hints: Vec::new(),
+        }
+    }
+
+    /// Replaces the linear solver (the default is [`FaerDirect`] with
+    /// sequential factorisation).
+    pub fn set_linear_solver(&mut self, linear: Box<dyn LinearSolver>) {
+        self.linear = linear;
+        self.analysed = false;
+    }
+
+    /// The linear solver.
+    pub fn linear_solver(&self) -> &dyn LinearSolver {
+        &*self.linear
+    }
+
+    /// Solves the load step from load factor `lambda0` to `lambda1`: the
+    /// stages of the module docs. On success the points hold the converged
+    /// state; on failure they are untouched.
+    pub fn solve_load_step(
+        &mut self,
+        points: &mut PointsOf<D, P>,
+        lambda0: f64,
+        lambda1: f64,
+    ) -> Result<StepReport<D>, StepError> {
+        self.prepare_step(points, lambda0, lambda1)?;
+        self.predict(lambda1 - lambda0);
+        let o = &self.options;
+        let mut monitor = NewtonMonitor::new(o.tolerance, o.divergence_factor, o.max_iterations);
+        let mut backtracked = Vec::new();
+        let mut initial_unbalance = None;
+        let retry = |cause, monitor: &NewtonMonitor| StepError::Retry {
+            cause,
+            last_residual: monitor.last(),
+        };
+        loop {
+            let iteration = monitor.iteration();
+            match self.update_material_points_backtracking(points, iteration > 0) {
+                Ok(true) => backtracked.push(iteration),
+                Ok(false) => {}
+                Err(cause) => return Err(retry(cause, &monitor)),
+            }
+            self.assemble_internal_force();
+            if iteration == 0 {
+                initial_unbalance = convergence::unbalance_all_dofs(&self.it.f_int, &self.it.f_ext);
+            }
+            let (r, d) = convergence::residual_parts(&self.system, &self.it.f_int, &self.it.f_ext);
+            match monitor.check(r, d) {
+                Verdict::Converged => break,
+                Verdict::Failed(cause) => return Err(retry(cause, &monitor)),
+                Verdict::Continue => {}
+            }
+            self.update_tangents(points)
+                .map_err(|cause| retry(cause, &monitor))?;
+            self.assemble_stiffness();
+            self.solve()
+                .map_err(|source| retry(StepFailure::LinearSolve { source }, &monitor))?;
+        }
+        let reaction = convergence::reaction(&self.system, &self.it.f_int, &self.it.f_ext);
+        self.commit(points)?;
+        // The mesh follows to the end of the step, with the points.
+        self.move_mesh(lambda1)?;
+        self.remember_increment(lambda1 - lambda0);
+        Ok(StepReport {
+            lambda0,
+            lambda1,
+            residuals: monitor.into_residuals(),
+            initial_unbalance,
+            reaction,
+            active_nodes: self.system.n_active(),
+            free_dofs: self.system.n_free,
+            factorisation: self.linear.last_factorisation(),
+            backtracked,
+        })
+    }
+
+    /// Normalised out-of-balance force (eq. 40):
+    /// $\|f^R\| / \|f^{ext} + f^{react}\|$, the residual taken over free
+    /// dofs and the reactions over prescribed ones.
+    pub fn normalised_residual(&self) -> f64 {
+        let (r, d) = convergence::residual_parts(&self.system, &self.it.f_int, &self.it.f_ext);
+        convergence::ratio(r, d)
+    }
+
+    /// The stiffness last assembled on the current load step's system (in
+    /// a converged step: at the last iterate before the final correction),
+    /// or `None` if the step converged without assembling one.
+    pub fn free_stiffness(&self) -> Option<FreeStiffness<'_>> {
+        self.it.stiffness_assembled.then(|| FreeStiffness {
+            n: self.system.n_free,
+            col_ptr: &self.system.col_ptr,
+            row_idx: &self.system.row_idx,
+            values: &self.it.values,
+        })
+    }
+}

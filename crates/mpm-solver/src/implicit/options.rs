@@ -1,0 +1,66 @@
+//! Newton–Raphson controls.
+
+/// Halvings of a Newton correction that inverts a material point before
+/// the step fails.
+pub const MAX_BACKTRACKS: usize = 10;
+
+/// Newton–Raphson controls.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonOptions {
+    /// Tolerance on the normalised out-of-balance force, eq. (40).
+    pub tolerance: f64,
+    /// Maximum number of iterations (linear solves) per step.
+    pub max_iterations: usize,
+    /// The step is declared divergent when the normalised residual exceeds
+    /// this factor times its value at iteration 0.
+    pub divergence_factor: f64,
+    /// Nodes whose support volume $\sum_p S_{vp}V^n_p$ is below this
+    /// fraction of the largest nodal support volume are held fixed over the
+    /// step. Such fringe nodes (a GIMP domain or B-spline stencil barely
+    /// reaching them) add next to no stiffness; left free they make the
+    /// stiffness nearly singular, and the nearly arbitrary increments they
+    /// receive would move the points through $S_{vp}\Delta u_v$ (eq. 31).
+    /// Zero disables the rule.
+    pub weak_node_threshold: f64,
+    /// Nodes whose stiffness weight $\sum_p |\nabla S_{vp}|^2 V^n_p$ is below
+    /// this fraction of the largest are held fixed over the step too. For
+    /// domain-based bases (GIMP, CPDI2, B-splines) value and gradient of a
+    /// fringe node vanish together, so holding it adds a reaction of the
+    /// order of $\sigma\,\nabla S_{vp}V_p$, which is small; left free, two
+    /// such nodes touched by one point only form a mechanism (a rotation
+    /// that strains no point) along which Newton iterates run away.
+    /// Standard MPM's far-side nodes keep gradients of order $1/h$ and are
+    /// not affected. Zero disables the rule.
+    pub weak_node_stiffness: f64,
+    /// Start each step's iterations from the previous step's converged
+    /// increment, scaled by the ratio of load increments, at the free
+    /// nodes that were active then (a secant predictor). Off, the free
+    /// nodes start at zero increment, as in Coombs et al. 2020. The
+    /// predictor saves iterations on smooth load paths and keeps Newton on
+    /// the branch of the previous step where the equilibrium path has
+    /// bifurcations (perfect plasticity).
+    pub predictor: bool,
+    /// Largest admissible $\max(\|\Delta F\|_F, \|\Delta F^{-1}\|_F)$ of
+    /// any material point within one load step (the identity has
+    /// $\sqrt3$; 10 allows principal stretches from about 0.1 to 9.9). An
+    /// iterate beyond it fails the step, which is retried with a smaller
+    /// increment: Newton iterates that slide along a near-mechanism grow a
+    /// point's stretch geometrically while the Hencky stress
+    /// $\propto \ln\lambda/\lambda$ and hence the residual decay, and would
+    /// otherwise "converge" with the point flung far away.
+    pub max_increment_norm: f64,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-9,
+            max_iterations: 30,
+            divergence_factor: 1e6,
+            weak_node_threshold: 1e-6,
+            weak_node_stiffness: 1e-4,
+            predictor: false,
+            max_increment_norm: 10.0,
+        }
+    }
+}

@@ -1,0 +1,103 @@
+//! What a load step reports: the converged step's figures, the stiffness
+//! it assembled, and why an attempt failed.
+
+use nalgebra::SVector;
+
+use crate::error::{SolverError, StepFailure};
+use crate::linear::{Factorisation, LinearSolveError};
+
+/// What one converged load step did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepReport<const D: usize> {
+    /// Load factor at the start of the step.
+    pub lambda0: f64,
+    /// Load factor at the end of the step.
+    pub lambda1: f64,
+    /// Normalised residual (eq. 40) at iterations 0, 1, ...
+    pub residuals: Vec<f64>,
+    /// The out-of-balance force at iteration 0 measured before the
+    /// reactions are known, $\|f^{ext} - f^{int}\| / \|f^{ext}\|$ over
+    /// every active dof, prescribed ones included: the first residual the
+    /// authors' code prints, so the iteration-0 row of Coombs et al.
+    /// (2020) Tables 3 and 8. Not a convergence measure: at prescribed
+    /// dofs $f^{int}$ carries the reactions of the previous step. `None`
+    /// when the step has no external force (displacement-driven steps).
+    pub initial_unbalance: Option<f64>,
+    /// Sum of the reactions at prescribed dofs, per component.
+    pub reaction: SVector<f64, D>,
+    /// Active nodes, free dofs and stiffness entries of the step.
+    pub active_nodes: usize,
+    /// Free degrees of freedom.
+    pub free_dofs: usize,
+    /// Factorisation used by the last solve.
+    pub factorisation: Option<Factorisation>,
+    /// Iterations (indices into `residuals`) whose Newton correction was
+    /// shortened by backtracking; the iterations after the last of them are
+    /// plain Newton steps.
+    pub backtracked: Vec<usize>,
+}
+
+impl<const D: usize> StepReport<D> {
+    /// Number of Newton iterations (linear solves).
+    pub fn iterations(&self) -> usize {
+        self.residuals.len().saturating_sub(1)
+    }
+}
+
+/// The stiffness over the free dofs as last assembled: compressed sparse
+/// columns, the full (not triangular) pattern, rows ascending within each
+/// column, free dofs numbered as in [`ImplicitSolver::free_increment`].
+#[derive(Debug, Clone, Copy)]
+pub struct FreeStiffness<'a> {
+    /// Free dofs (rows and columns).
+    pub n: usize,
+    /// Column pointers (`n + 1`).
+    pub col_ptr: &'a [usize],
+    /// Row index of each entry.
+    pub row_idx: &'a [usize],
+    /// Value of each entry.
+    pub values: &'a [f64],
+}
+
+impl FreeStiffness<'_> {
+    /// A copy as a `sprs` matrix (for export or inspection), checked for
+    /// a consistent structure.
+    ///
+    /// # Errors
+    /// [`SolverError::Pattern`] if the arrays do not form a CSC matrix
+    /// (which would be a bug of the assembly).
+    pub fn to_sprs(&self) -> Result<sprs::CsMat<f64>, SolverError> {
+        sprs::CsMat::try_new_csc(
+            (self.n, self.n),
+            self.col_ptr.to_vec(),
+            self.row_idx.to_vec(),
+            self.values.to_vec(),
+        )
+        .map_err(|_| {
+            SolverError::Pattern(LinearSolveError::InvalidPattern {
+                n: self.n,
+                reason: "the assembled stiffness is not a CSC matrix",
+            })
+        })
+    }
+}
+
+/// Failure of one attempt at a load step.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepError {
+    /// The step may succeed with a smaller increment.
+    Retry {
+        /// The cause.
+        cause: StepFailure,
+        /// The last normalised residual.
+        last_residual: f64,
+    },
+    /// The simulation cannot continue (e.g. a point left the grid).
+    Fatal(SolverError),
+}
+
+impl From<SolverError> for StepError {
+    fn from(e: SolverError) -> Self {
+        StepError::Fatal(e)
+    }
+}

@@ -1,0 +1,345 @@
+//! The stages of a load step as methods of [`ImplicitSolver`], each a thin
+//! binding of the solver's state to the reusable functions of
+//! [`crate::stages`], plus the constitutive update and tangents, which
+//! depend on the formulation.
+
+use mpm_constitutive::tensor::Tensor4;
+use mpm_constitutive::{ConsistentTangent, LogStrainLaw, MaterialState, update};
+use nalgebra::{Matrix3, SVector};
+use rayon::prelude::*;
+
+use super::{ImplicitSolver, MAX_BACKTRACKS};
+use crate::boundary::{Constraints, StepView};
+use crate::error::{SolverError, StepFailure};
+use crate::formulation::Formulation;
+use crate::linear::LinearSolveError;
+use crate::locking::LockingTreatment;
+use crate::mesh::NodalMesh;
+use crate::parts::{PointsOf, SolverParts};
+use crate::stages::system::NONE;
+use crate::stages::{basis, gather, update as grid_to_point};
+
+/// The material point a failure names, if any.
+fn failed_point(f: &StepFailure) -> Option<usize> {
+    match f {
+        StepFailure::Constitutive { point, .. } | StepFailure::ExcessiveIncrement { point, .. } => {
+            Some(*point)
+        }
+        _ => None,
+    }
+}
+
+impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
+    /// Stage 0: a moving mesh takes its position at load factor `lambda0`
+    /// ([`Constraints::move_mesh`]; nothing for a fixed mesh). Called at
+    /// the start of every step attempt and after every converged step, so
+    /// that mesh and points always belong to the same load factor.
+    pub fn move_mesh(&mut self, lambda0: f64) -> Result<(), SolverError> {
+        self.constraints
+            .move_mesh(&mut self.mesh, lambda0)
+            .map_err(|source| SolverError::MeshMotion {
+                load_factor: lambda0,
+                source,
+            })
+    }
+
+    /// Stage 1: basis values and gradients of every point at the start of
+    /// the step ([`crate::stages::basis::evaluate`]).
+    pub fn evaluate_basis(&mut self, points: &PointsOf<D, P>) -> Result<(), SolverError> {
+        basis::evaluate(
+            &self.basis,
+            &self.mesh,
+            &points.position,
+            &points.domain,
+            &mut self.hints,
+            &mut self.system,
+        )
+    }
+
+    /// Stage 2: active nodes, dofs, prescribed increments, adjacency,
+    /// sparsity pattern and the symbolic factorisation.
+    pub fn build_system(
+        &mut self,
+        volumes: &[f64],
+        lambda0: f64,
+        lambda1: f64,
+    ) -> Result<(), SolverError> {
+        let node_count = self.mesh.node_count();
+        let sys = &mut self.system;
+        sys.number_nodes(node_count);
+        sys.build_adjacency();
+        sys.build_neighbours();
+        let (support, stiffness) = gather::support_weights(sys, volumes);
+        let max = |x: &[f64]| x.iter().copied().fold(0.0, f64::max);
+        let (support_cut, stiffness_cut) = (
+            self.options.weak_node_threshold * max(&support),
+            self.options.weak_node_stiffness * max(&stiffness),
+        );
+        let weak: Vec<bool> = support
+            .iter()
+            .zip(&stiffness)
+            .map(|(&s, &k)| s < support_cut || k < stiffness_cut)
+            .collect();
+        let constraints = &self.constraints;
+        let active_of_mesh = std::mem::take(&mut sys.active_of_mesh);
+        sys.build_pattern(|node, i| {
+            let held = weak[active_of_mesh[node] as usize];
+            constraints
+                .prescribed(node, i, lambda0, lambda1)
+                .or(held.then_some(0.0))
+        });
+        sys.active_of_mesh = active_of_mesh;
+        let n_dofs = D * sys.n_active();
+        let it = &mut self.it;
+        it.du.clear();
+        it.du.extend_from_slice(&sys.prescribed);
+        it.f_int.clear();
+        it.f_int.resize(n_dofs, 0.0);
+        it.f_ext.clear();
+        it.f_ext.resize(n_dofs, 0.0);
+        it.values.clear();
+        it.values.resize(sys.row_idx.len(), 0.0);
+        it.stiffness_assembled = false;
+        let symmetric = <P::Law as LogStrainLaw>::SYMMETRIC_TANGENT
+            && !<P::Locking as LockingTreatment>::COUPLES_POINTS;
+        self.analysed = false;
+        self.linear
+            .analyse(sys.n_free, &sys.col_ptr, &sys.row_idx, symmetric)
+            .map_err(SolverError::Pattern)?;
+        self.analysed = true;
+        Ok(())
+    }
+
+    /// Stage 3: the external force of the step
+    /// ([`crate::stages::gather::external_force`]), constant over the step.
+    pub fn assemble_external_force(&mut self, points: &PointsOf<D, P>, lambda1: f64) {
+        gather::external_force(&self.system, points, lambda1, &mut self.it.f_ext);
+    }
+
+    /// Stage 4a with backtracking: when a Newton correction inverts a
+    /// material point (det ΔF <= 0 or another constitutive failure) or
+    /// stretches it beyond [`super::NewtonOptions::max_increment_norm`],
+    /// the correction is halved, up to [`MAX_BACKTRACKS`] times, before the
+    /// step is declared failed. Sparsely populated cells give nodes with
+    /// little stiffness whose corrections can overshoot; backtracking keeps
+    /// Newton on track without changing the converged solution.
+    pub(super) fn update_material_points_backtracking(
+        &mut self,
+        points: &PointsOf<D, P>,
+        after_solve: bool,
+    ) -> Result<bool, StepFailure> {
+        let mut result = self.update_material_points(points);
+        let mut backtracks = 0;
+        while let Err(StepFailure::Constitutive { .. } | StepFailure::ExcessiveIncrement { .. }) =
+            result
+        {
+            if !after_solve || backtracks == MAX_BACKTRACKS {
+                break;
+            }
+            backtracks += 1;
+            let sys = &self.system;
+            let it = &mut self.it;
+            for (dof, &free) in sys.free_of_dof.iter().enumerate() {
+                if free != NONE {
+                    let half = 0.5 * it.rhs[free as usize];
+                    it.du[dof] -= half;
+                    it.rhs[free as usize] = half;
+                }
+            }
+            result = self.update_material_points(points);
+        }
+        result.map(|()| backtracks > 0)
+    }
+
+    /// Stage 4a: for every point, $\Delta F$ from the grid displacement
+    /// increment (eq. 7), the locking treatment, the constitutive update
+    /// and the weighted stress of the formulation.
+    pub fn update_material_points(&mut self, points: &PointsOf<D, P>) -> Result<(), StepFailure> {
+        let n = points.len();
+        let sys = &self.system;
+        let it = &mut self.it;
+        let maps_gradients = <P::Formulation as Formulation>::MAPS_GRADIENTS;
+        it.responses.resize(n, None);
+        it.stress_w.resize(n, Matrix3::zeros());
+        if maps_gradients {
+            it.mapped.resize(sys.grads.len(), SVector::zeros());
+        }
+        let du = &it.du;
+        if <P::Locking as LockingTreatment>::COUPLES_POINTS {
+            it.increments.resize(n, Matrix3::identity());
+            it.increments
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(p, m)| *m = grid_to_point::deformation_increment(sys, du, p));
+            it.volumes.clear();
+            it.volumes.extend_from_slice(&points.volume);
+            self.locking.prepare(&it.increments, &it.volumes);
+        }
+        let (law, locking) = (&self.law, &self.locking);
+        let limit = self.options.max_increment_norm;
+        let stride = sys.stride;
+        let mapped_chunks = it.mapped.par_chunks_mut(stride.max(1));
+        let failure = it
+            .responses
+            .par_iter_mut()
+            .zip(it.stress_w.par_iter_mut())
+            .enumerate()
+            .map(|(p, (response, stress))| {
+                let delta_f = locking
+                    .modified_increment(p, &grid_to_point::deformation_increment(sys, du, p));
+                let state = MaterialState {
+                    be: points.be[p],
+                    history: points.history[p],
+                };
+                match update(law, &delta_f, &points.f[p], &state) {
+                    Ok(r) => {
+                        let norm = r.delta_f.norm().max(r.delta_f_inv.norm());
+                        if norm > limit {
+                            return Some(StepFailure::ExcessiveIncrement {
+                                point: p,
+                                norm,
+                                limit,
+                            });
+                        }
+                        *stress = P::Formulation::stress(&r)
+                            * P::Formulation::volume(&r, points.volume[p]);
+                        *response = Some(r);
+                        None
+                    }
+                    Err(source) => Some(StepFailure::Constitutive { point: p, source }),
+                }
+            })
+            .reduce(
+                || None,
+                // The failure of the lowest point, whatever the thread count.
+                |a, b| match (
+                    a.as_ref().and_then(failed_point),
+                    b.as_ref().and_then(failed_point),
+                ) {
+                    (Some(pa), Some(pb)) if pb < pa => b,
+                    (Some(_), _) => a,
+                    _ => b,
+                },
+            );
+        if let Some(f) = failure {
+            return Err(f);
+        }
+        if maps_gradients {
+            let responses = &it.responses;
+            mapped_chunks.enumerate().for_each(|(p, chunk)| {
+                if let Some(r) = &responses[p] {
+                    for (a, s) in sys.slots(p).enumerate() {
+                        chunk[a] = P::Formulation::map_gradient(r, &sys.grads[s]);
+                    }
+                }
+            });
+        }
+        Ok(())
+    }
+
+    /// The basis gradients of the force and stiffness: the step's, or
+    /// mapped by eq. (8) for formulations that map them.
+    fn force_gradients(&self) -> &[SVector<f64, D>] {
+        if <P::Formulation as Formulation>::MAPS_GRADIENTS {
+            &self.it.mapped
+        } else {
+            &self.system.grads
+        }
+    }
+
+    /// Stage 4b: the internal force (eqs. 6, 23, 28;
+    /// [`crate::stages::gather::internal_force`]).
+    pub fn assemble_internal_force(&mut self) {
+        let mut f_int = std::mem::take(&mut self.it.f_int);
+        gather::internal_force(
+            &self.system,
+            self.force_gradients(),
+            &self.it.stress_w,
+            &mut f_int,
+        );
+        self.it.f_int = f_int;
+    }
+
+    /// Stage 4c: the formulation's consistent tangent at every point,
+    /// weighted by its integration volume.
+    pub fn update_tangents(&mut self, points: &PointsOf<D, P>) -> Result<(), StepFailure> {
+        let law = &self.law;
+        let it = &mut self.it;
+        it.tangent_w.resize(it.responses.len(), Tensor4::zeros());
+        it.tangent_w
+            .par_iter_mut()
+            .zip(it.responses.par_iter())
+            .enumerate()
+            .try_for_each(|(p, (t, r))| {
+                if let Some(r) = r {
+                    let volume = P::Formulation::volume(r, points.volume[p]);
+                    *t = <P::Formulation as Formulation>::Tangent::tangent(law, r)
+                        .map_err(|source| StepFailure::Constitutive { point: p, source })?
+                        * volume;
+                }
+                Ok(())
+            })
+    }
+
+    /// Stage 4d: the stiffness (eqs. 4/21, 27) in CSC over free dofs
+    /// ([`crate::stages::gather::stiffness`]).
+    pub fn assemble_stiffness(&mut self) {
+        let mut values = std::mem::take(&mut self.it.values);
+        gather::stiffness(
+            &self.system,
+            self.force_gradients(),
+            &self.it.tangent_w,
+            &mut values,
+        );
+        self.it.values = values;
+        self.it.stiffness_assembled = true;
+    }
+
+    /// Stage 4e: solve $K\,\delta d = -f^R$ (eq. 26) with the linear
+    /// solver and accumulate the increment (eq. 30).
+    pub fn solve(&mut self) -> Result<(), LinearSolveError> {
+        if !self.analysed {
+            return Err(LinearSolveError::NotAnalysed);
+        }
+        let sys = &self.system;
+        let it = &mut self.it;
+        it.rhs.clear();
+        it.rhs.resize(sys.n_free, 0.0);
+        for (dof, &free) in sys.free_of_dof.iter().enumerate() {
+            if free != NONE {
+                it.rhs[free as usize] = it.f_ext[dof] - it.f_int[dof];
+            }
+        }
+        self.linear.solve(&it.values, &mut it.rhs)?;
+        for (dof, &free) in sys.free_of_dof.iter().enumerate() {
+            if free != NONE {
+                it.du[dof] += it.rhs[free as usize];
+            }
+        }
+        Ok(())
+    }
+
+    /// Stage 5: positions (eq. 31), converged deformation and stresses,
+    /// volumes (eq. 22) and domains ([`crate::stages::update::commit`]).
+    pub fn commit(&mut self, points: &mut PointsOf<D, P>) -> Result<(), SolverError> {
+        grid_to_point::commit(
+            &self.system,
+            &self.it.du,
+            &self.mesh,
+            &self.updater,
+            &self.it.responses,
+            points,
+        )
+    }
+
+    /// The view [`Constraints::begin_step`] receives.
+    pub(super) fn begin_constraints(&mut self, points: &PointsOf<D, P>) {
+        let sys = &self.system;
+        self.constraints.begin_step(&StepView::new(
+            &points.position,
+            &sys.nodes,
+            &sys.counts,
+            sys.stride,
+        ));
+    }
+}

@@ -1,0 +1,142 @@
+//! The `LinearSolver` plug point: the solve $K\,\delta d = -f^R$ of every
+//! Newton iteration (Coombs et al. 2020 eq. 26).
+//!
+//! A solver is bound to one sparsity pattern per load step
+//! ([`LinearSolver::analyse`]: the active set, and with it the pattern,
+//! changes only between steps) and then solves once per iteration with new
+//! values ([`LinearSolver::solve`]), so symbolic work is done once per
+//! step. [`FaerDirect`] (supernodal Cholesky with an LU fallback, faer) is
+//! the first implementation; an iterative solver or a distributed one
+//! implements the same two calls. Parallelism is a parameter of the
+//! implementation ([`FaerDirect::new`]), never a process-global setting.
+
+mod faer_direct;
+
+pub use faer_direct::FaerDirect;
+
+use thiserror::Error;
+
+/// Which factorisation (or method) solved the last system.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Factorisation {
+    /// Sparse Cholesky $LL^T$ (lower triangle).
+    Cholesky,
+    /// Sparse LU with partial pivoting.
+    Lu,
+}
+
+/// Why a linear solve failed; every variant says where.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum LinearSolveError {
+    /// The pattern handed to [`LinearSolver::analyse`] is not a valid
+    /// compressed-sparse-column pattern (a bug of the assembly).
+    #[error("invalid sparsity pattern of a {n}×{n} matrix: {reason}")]
+    InvalidPattern {
+        /// Matrix size.
+        n: usize,
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// [`LinearSolver::solve`] was called with values or a right-hand
+    /// side whose length does not match the analysed pattern.
+    #[error("expected {expected} {what}, got {got}")]
+    Dimension {
+        /// `"values"` or `"right-hand side entries"`.
+        what: &'static str,
+        /// Length of the analysed pattern.
+        expected: usize,
+        /// Length received.
+        got: usize,
+    },
+    /// No pattern has been analysed for this step.
+    #[error("no sparsity pattern has been analysed for this load step")]
+    NotAnalysed,
+    /// LU found no usable pivot in column `index` of the (permuted)
+    /// stiffness: the stiffness is singular there (an unsupported node or
+    /// a mechanism).
+    #[error("sparse LU found no pivot at column {index}: the stiffness is singular")]
+    SingularPivot {
+        /// Column of the failed pivot.
+        index: usize,
+    },
+    /// The factorisation ran out of memory or overflowed its index type.
+    #[error("the {stage} ran out of memory or overflowed its index type")]
+    Resources {
+        /// `"symbolic analysis"` or `"numeric factorisation"`.
+        stage: &'static str,
+    },
+    /// The solution has a non-finite entry: the stiffness is singular or
+    /// its values are not finite.
+    #[error(
+        "{factorisation:?} solve produced a non-finite value at free dof {dof} (singular stiffness or non-finite entries)"
+    )]
+    NonFinite {
+        /// The factorisation used.
+        factorisation: Factorisation,
+        /// First free dof with a non-finite value.
+        dof: usize,
+    },
+}
+
+/// A linear solver for the stiffness of a load step (module docs).
+pub trait LinearSolver: Send + std::fmt::Debug {
+    /// Binds the solver to the pattern of an `n × n` matrix in compressed
+    /// sparse columns (`col_ptr` of length `n + 1`, rows ascending within
+    /// each column, the full pattern rather than one triangle). `symmetric`
+    /// says whether the values will be symmetric (then Cholesky may be
+    /// used). Called once per load step.
+    ///
+    /// # Errors
+    /// [`LinearSolveError::InvalidPattern`] or
+    /// [`LinearSolveError::Resources`].
+    fn analyse(
+        &mut self,
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        symmetric: bool,
+    ) -> Result<(), LinearSolveError>;
+
+    /// Solves $K x = b$ in place for the values `values` in the analysed
+    /// pattern: `rhs` holds $b$ on entry and $x$ on exit.
+    ///
+    /// # Errors
+    /// See [`LinearSolveError`]; the solution is never silently non-finite.
+    fn solve(&mut self, values: &[f64], rhs: &mut [f64])
+    -> Result<Factorisation, LinearSolveError>;
+
+    /// The factorisation used by the last successful solve.
+    fn last_factorisation(&self) -> Option<Factorisation>;
+
+    /// Number of stored entries of the analysed pattern.
+    fn nnz(&self) -> usize;
+}
+
+impl<S: LinearSolver + ?Sized> LinearSolver for Box<S> {
+    fn analyse(
+        &mut self,
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        symmetric: bool,
+    ) -> Result<(), LinearSolveError> {
+        (**self).analyse(n, col_ptr, row_idx, symmetric)
+    }
+
+    fn solve(
+        &mut self,
+        values: &[f64],
+        rhs: &mut [f64],
+    ) -> Result<Factorisation, LinearSolveError> {
+        (**self).solve(values, rhs)
+    }
+
+    fn last_factorisation(&self) -> Option<Factorisation> {
+        (**self).last_factorisation()
+    }
+
+    fn nnz(&self) -> usize {
+        (**self).nnz()
+    }
+}

@@ -1,0 +1,226 @@
+//! Point-to-grid gathers: lumped nodal mass, external force (eqs. 24, 25,
+//! 29), internal force (eqs. 6, 23, 28) and the stiffness (eqs. 4, 21, 27),
+//! over a [`StepSystem`] and slices of per-point quantities.
+//!
+//! Node-wise gathers (mass, internal force, stiffness) run one active node
+//! (or block column) per task and sum over the node's points in ascending
+//! order, so the result is bit-identical for any number of threads.
+
+use mpm_constitutive::tensor::{Tensor4, idx};
+use nalgebra::{Matrix3, SVector};
+use rayon::prelude::*;
+
+use crate::points::MaterialPoints;
+use crate::stages::system::{NONE, StepSystem};
+
+/// Lumped nodal mass $m_v = \sum_p S_{vp} m_p$ per active node (MPoint
+/// eq. 22; the explicit solver's), into `out` (resized).
+pub fn nodal_mass<const D: usize>(sys: &StepSystem<D>, mass: &[f64], out: &mut Vec<f64>) {
+    out.clear();
+    out.resize(sys.n_active(), 0.0);
+    out.par_iter_mut().enumerate().for_each(|(v, m)| {
+        *m = sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]]
+            .iter()
+            .map(|&(p, a)| sys.values[p as usize * sys.stride + a as usize] * mass[p as usize])
+            .sum();
+    });
+}
+
+/// Adds $\text{scale}\,S_{vp}\,f$ to the nodes of point `p`.
+#[inline]
+fn scatter<const D: usize>(
+    sys: &StepSystem<D>,
+    f_ext: &mut [f64],
+    p: usize,
+    scale: f64,
+    force: &SVector<f64, D>,
+) {
+    for s in sys.slots(p) {
+        let v = sys.nodes[s] as usize;
+        for i in 0..D {
+            f_ext[D * v + i] += scale * sys.values[s] * force[i];
+        }
+    }
+}
+
+/// $f^{ext} \mathrel{+}= \lambda_1\sum_p [S_{vp}]^T(b_p + f_p)$ (eqs. 24,
+/// 25, 29), plus the non-proportional body force
+/// $\sum_p [S_{vp}]^T b_p(\lambda_1)$ when the points have one. Points
+/// without loads cost nothing: the loops run over the loads present.
+pub fn external_force<const D: usize, H, Dom>(
+    sys: &StepSystem<D>,
+    points: &MaterialPoints<D, H, Dom>,
+    lambda1: f64,
+    f_ext: &mut [f64],
+) {
+    for (p, b) in points.body_force.iter().enumerate() {
+        scatter(sys, f_ext, p, lambda1, b);
+    }
+    for (p, force) in &points.point_force {
+        scatter(sys, f_ext, *p, lambda1, force);
+    }
+    if let Some(path) = &points.body_force_path {
+        for p in 0..points.position.len() {
+            scatter(sys, f_ext, p, 1.0, &(path.0)(p, lambda1));
+        }
+    }
+}
+
+/// $f^{int}_v = \sum_p [\nabla S_{vp}]^T\{\sigma\}V$ (eqs. 6, 23, 28) from
+/// each point's volume-weighted stress `stress_w` and the gradients
+/// `grads` (the step's, or mapped by eq. 8), one active node per task.
+pub fn internal_force<const D: usize>(
+    sys: &StepSystem<D>,
+    grads: &[SVector<f64, D>],
+    stress_w: &[Matrix3<f64>],
+    f_int: &mut [f64],
+) {
+    f_int.par_chunks_mut(D).enumerate().for_each(|(v, f)| {
+        f.iter_mut().for_each(|x| *x = 0.0);
+        for &(p, a) in &sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]] {
+            let s = p as usize * sys.stride + a as usize;
+            let sw = &stress_w[p as usize];
+            for i in 0..D {
+                for j in 0..D {
+                    f[i] += sw[(i, j)] * grads[s][j];
+                }
+            }
+        }
+    });
+}
+
+/// The stiffness (eqs. 4/21, 27) in the step's CSC pattern over free
+/// dofs, $K_{(vi)(wk)} = \sum_p \nabla_j S_{vp}\,T_{ijkl}\,\nabla_l S_{wp}$
+/// with each point's volume-weighted tangent `tangent_w`; one block column
+/// (active node $w$) per task, each entry summed over points in ascending
+/// order.
+pub fn stiffness<const D: usize>(
+    sys: &StepSystem<D>,
+    grads: &[SVector<f64, D>],
+    tangent_w: &[Tensor4],
+    values: &mut [f64],
+) {
+    let block = |w: usize, vals: &mut [f64]| {
+        vals.iter_mut().for_each(|x| *x = 0.0);
+        let nbs = &sys.nb[sys.nb_ptr[w]..sys.nb_ptr[w + 1]];
+        let map = &sys.block_map[sys.nb_ptr[w] * D * D..sys.nb_ptr[w + 1] * D * D];
+        for &(p, b) in &sys.adj[sys.adj_ptr[w]..sys.adj_ptr[w + 1]] {
+            let p = p as usize;
+            let t = &tangent_w[p];
+            let gw = &grads[p * sys.stride + b as usize];
+            // q[i][j][k] = Σ_l T_(ij)(kl) g_w,l
+            let mut q = [[[0.0f64; D]; D]; D];
+            for i in 0..D {
+                for j in 0..D {
+                    for k in 0..D {
+                        let mut acc = 0.0;
+                        for l in 0..D {
+                            acc += t[(idx(i, j), idx(k, l))] * gw[l];
+                        }
+                        q[i][j][k] = acc;
+                    }
+                }
+            }
+            for s in sys.slots(p) {
+                let v = sys.nodes[s];
+                let pos = match nbs.binary_search(&v) {
+                    Ok(pos) => pos,
+                    Err(_) => continue,
+                };
+                let gv = &grads[s];
+                for i in 0..D {
+                    for k in 0..D {
+                        let off = map[(pos * D + i) * D + k];
+                        if off != NONE {
+                            let mut acc = 0.0;
+                            for j in 0..D {
+                                acc += gv[j] * q[i][j][k];
+                            }
+                            vals[off as usize] += acc;
+                        }
+                    }
+                }
+            }
+        }
+    };
+    split_blocks(0, sys.n_active(), values, 0, &sys.block_ptr, &block);
+}
+
+/// Runs `f(w, values_of_block_w)` for the block columns `lo..hi` in
+/// parallel, splitting `vals` (which starts at block `lo`, value index
+/// `base`) into disjoint slices at block boundaries.
+fn split_blocks<F>(lo: usize, hi: usize, vals: &mut [f64], base: usize, block_ptr: &[usize], f: &F)
+where
+    F: Fn(usize, &mut [f64]) + Sync,
+{
+    const GRAIN: usize = 64;
+    if hi - lo <= GRAIN {
+        let mut rest = vals;
+        for w in lo..hi {
+            let len = block_ptr[w + 1] - block_ptr[w];
+            let (head, tail) = rest.split_at_mut(len);
+            f(w, head);
+            rest = tail;
+        }
+        return;
+    }
+    let mid = (lo + hi) / 2;
+    let (left, right) = vals.split_at_mut(block_ptr[mid] - base);
+    rayon::join(
+        || split_blocks(lo, mid, left, base, block_ptr, f),
+        || split_blocks(mid, hi, right, block_ptr[mid], block_ptr, f),
+    );
+}
+
+/// Per active node, the support $\sum_p S_{vp}V_p$ and the stiffness
+/// weight $\sum_p|\nabla S_{vp}|^2V_p$ (the fringe-node rules of
+/// [`crate::NewtonOptions`]).
+pub fn support_weights<const D: usize>(
+    sys: &StepSystem<D>,
+    volumes: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    (0..sys.n_active())
+        .map(|v| {
+            sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]].iter().fold(
+                (0.0, 0.0),
+                |(s, k), &(p, a)| {
+                    let slot = p as usize * sys.stride + a as usize;
+                    let volume = volumes[p as usize];
+                    (
+                        s + sys.values[slot] * volume,
+                        k + sys.grads[slot].norm_squared() * volume,
+                    )
+                },
+            )
+        })
+        .unzip()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two points on a 1D-like chain of three nodes in 2D.
+    fn system() -> StepSystem<2> {
+        let mut sys = StepSystem::<2> {
+            stride: 2,
+            nodes: vec![5, 7, 7, 9],
+            values: vec![0.25, 0.75, 0.5, 0.5],
+            grads: vec![SVector::<f64, 2>::new(-1.0, 0.0); 4],
+            counts: vec![2, 2],
+            ..StepSystem::default()
+        };
+        sys.number_nodes(10);
+        sys.build_adjacency();
+        sys
+    }
+
+    #[test]
+    fn nodal_mass_conserves_the_total_mass() {
+        let sys = system();
+        let mut m = Vec::new();
+        nodal_mass(&sys, &[2.0, 4.0], &mut m);
+        assert_eq!(m, vec![0.5, 1.5 + 2.0, 2.0]);
+        assert_eq!(m.iter().sum::<f64>(), 6.0);
+    }
+}
