@@ -1,11 +1,11 @@
 //! Closed-form solutions, plastic consistency and bad-input handling.
 #![allow(clippy::unwrap_used)]
 
-mod common;
-
 use approx::assert_relative_eq;
-use common::*;
 use mpm_constitutive::tensor::embed;
+use mpm_constitutive::verification::strategies::{
+    config, deformation_gradient, poisson_ratio, rotation,
+};
 use mpm_constitutive::{
     ConsistentTangent, ConstitutiveError, HenckyElastic, MaterialState, PreviouslyConvergedTangent,
     SpatialTangent, SymSpectral, VonMises, VonMisesHistory, update,
@@ -126,7 +126,7 @@ fn plane_strain_tangents_have_no_out_of_plane_coupling_in_first_index_pairs() {
 }
 
 proptest! {
-    #![proptest_config(common::config())]
+    #![proptest_config(config())]
 
     /// After a plastic return the state lies on the yield surface:
     /// f = 2μ‖dev ε^e‖ − ρ_y(α) ≤ 1e-10 ρ_y, evaluated from the returned

@@ -5,14 +5,17 @@
 //! perfect and hardening plasticity.
 #![allow(clippy::unwrap_used)]
 
-mod common;
-
-use common::*;
-use mpm_constitutive::driver::cauchy_stress_derivative;
 use mpm_constitutive::tensor::Tensor4;
+use mpm_constitutive::verification::strategies::{
+    config, converged_state, deformation_gradient, poisson_ratio, rotation,
+};
+use mpm_constitutive::verification::{
+    SpatialErrors, TOLERANCE, check_algorithmic_tangent, check_previously_converged, check_spatial,
+    hencky_strain, jacobian, plastic_scale, relative_error, sym_unit,
+};
 use mpm_constitutive::{
     ConsistentTangent, HenckyElastic, LogStrainLaw, MaterialState, PreviouslyConvergedTangent,
-    SpatialTangent, SymSpectral, VonMises, VonMisesHistory, update,
+    SymSpectral, VonMises, VonMisesHistory, update,
 };
 use nalgebra::Matrix3;
 use proptest::prelude::*;
@@ -20,28 +23,17 @@ use proptest::prelude::*;
 /// Required agreement of analytic and finite-difference tangents.
 const TOL: f64 = 1e-6;
 /// Finite-difference step relative to the smallest principal stretch (or
-/// eigenvalue) of the argument; see `common::central_difference`.
+/// eigenvalue) of the argument; see
+/// `mpm_constitutive::verification::central_difference`.
 const STEP: f64 = 1e-4;
 
-/// Extra factor on the step for yielding states: the flow direction
-/// N = dev ε/‖dev ε‖ turns on the scale of ‖dev ε^tr‖, so the perturbation
-/// of the strain must stay well below it (10 % of it at most).
-fn plastic_scale(trial_strain: &nalgebra::Vector3<f64>, yielded: bool) -> f64 {
-    if !yielded {
-        return 1.0;
-    }
-    let dev = trial_strain.map(|e| e - trial_strain.sum() / 3.0).norm();
-    (10.0 * dev).min(1.0)
-}
-
-/// A random converged state: F_n with moderate stretches and, for the
-/// plastic model, a b_e^n that differs from F_n F_n^T (earlier plastic flow).
-fn converged_state() -> impl Strategy<Value = (Matrix3<f64>, Matrix3<f64>)> {
-    (
-        deformation_gradient(0.8, 1.25),
-        deformation_gradient(0.8, 1.25),
-    )
-        .prop_map(|(f_n, fe_n)| (f_n, fe_n * fe_n.transpose()))
+/// The exported defaults that `law_tangent_properties!` uses are the ones
+/// of these tests.
+#[test]
+fn exported_tolerance_and_step_are_the_tests_own() {
+    assert_eq!(TOLERANCE, TOL);
+    assert_eq!(mpm_constitutive::verification::STEP, STEP);
+    assert_eq!(mpm_constitutive::verification::strategies::CASES, 256);
 }
 
 /// A von Mises model whose yield stress is a random fraction of the trial
@@ -73,65 +65,16 @@ fn von_mises_for(
     VonMises::new(e, nu, rho_y, h).unwrap()
 }
 
-/// Ã against ∂P̃/∂ΔF (eqs. 18, A.3), for any law; `None` when the
-/// finite-difference stencil crosses the yield surface.
-fn check_previously_converged<L: LogStrainLaw>(
-    law: &L,
-    delta_f: &Matrix3<f64>,
-    f_n: &Matrix3<f64>,
-    state: &MaterialState<L::History>,
-) -> Option<f64> {
-    let r = update(law, delta_f, f_n, state).unwrap();
-    let a = PreviouslyConvergedTangent::tangent(law, &r).unwrap();
-    let h =
-        STEP * min_singular_value(delta_f) * plastic_scale(&r.trial_strain().values, r.yielded());
-    let fd = jacobian(
-        |d| {
-            let p = update(law, &(delta_f + d), f_n, state).unwrap();
-            (p.yielded() == r.yielded()).then(|| p.p_tilde())
-        },
-        unit,
-        h,
-    )?;
-    Some(rel(&a, &fd))
-}
-
-/// a against the push-forward J⁻¹F_jm (∂P_im/∂F_kn) F_ln with P = τF^{-T},
-/// and (∂σ_ij/∂F_km)F_lm against a − σ_ij δ_kl + σ_il δ_jk, both with the
-/// perturbation dF = G F (i.e. ΔF → (1 + tG)ΔF).
-fn check_spatial<L: LogStrainLaw>(
-    law: &L,
-    delta_f: &Matrix3<f64>,
-    f_n: &Matrix3<f64>,
-    state: &MaterialState<L::History>,
-) -> Option<(f64, f64)> {
-    let r = update(law, delta_f, f_n, state).unwrap();
-    let a = SpatialTangent::tangent(law, &r).unwrap();
-    let h = STEP * min_singular_value(delta_f) / delta_f.norm()
-        * plastic_scale(&r.trial_strain().values, r.yielded());
-    let perturbed = |g: &Matrix3<f64>| {
-        let p = update(law, &((Matrix3::identity() + g) * delta_f), f_n, state).unwrap();
-        (p.yielded() == r.yielded()).then_some(p)
-    };
-    let fd_push = jacobian(
-        |g| {
-            perturbed(g)
-                .map(|p| p.tau * p.f.try_inverse().unwrap().transpose() * r.f.transpose() / r.j)
-        },
-        unit,
-        h,
-    )?;
-    let fd_cauchy = jacobian(|g| perturbed(g).map(|p| p.sigma), unit, h)?;
-    let literal = cauchy_stress_derivative(&a, &r.sigma);
-    // The literal derivative is a minus geometric terms of the size of σ;
-    // where they nearly cancel, its accuracy is limited by the size of the
-    // terms, so the error is measured against max(‖(∂σ/∂F)F‖, ‖a‖).
-    let literal_error = (literal - fd_cauchy).norm() / fd_cauchy.norm().max(a.norm());
-    Some((rel(&a, &fd_push), literal_error))
-}
+// The macro a downstream law uses, instantiated for the crate's two laws:
+// the yield stress E/2 gives elastic and yielding steps over the drawn
+// stretches 0.2–5.
+mpm_constitutive::law_tangent_properties!(hencky_macro, HenckyElastic::new);
+mpm_constitutive::law_tangent_properties!(von_mises_macro, |e, nu| {
+    VonMises::new(e, nu, 0.5 * e, 0.1 * e)
+});
 
 proptest! {
-    #![proptest_config(common::config())]
+    #![proptest_config(config())]
 
     #[test]
     fn hencky_previously_converged_tangent_matches_finite_differences(
@@ -142,7 +85,7 @@ proptest! {
     ) {
         let law = HenckyElastic::new(e, nu).unwrap();
         let state = MaterialState { be: f_n * f_n.transpose(), history: () };
-        let err = check_previously_converged(&law, &delta_f, &f_n, &state).unwrap();
+        let err = check_previously_converged(&law, &delta_f, &f_n, &state, STEP).unwrap().unwrap();
         prop_assert!(err <= TOL, "relative error {err:e}");
     }
 
@@ -157,7 +100,7 @@ proptest! {
     ) {
         let law = von_mises_for(1e4, nu, fraction, hardening_ratio, &delta_f, &be_n, alpha_n);
         let state = MaterialState { be: be_n, history: VonMisesHistory { alpha: alpha_n } };
-        let err = check_previously_converged(&law, &delta_f, &f_n, &state);
+        let err = check_previously_converged(&law, &delta_f, &f_n, &state, STEP).unwrap();
         prop_assume!(err.is_some(), "stencil crosses the yield surface");
         let err = err.unwrap();
         prop_assert!(err <= TOL, "relative error {err:e}");
@@ -171,7 +114,8 @@ proptest! {
     ) {
         let law = HenckyElastic::new(2e5, nu).unwrap();
         let state = MaterialState { be: f_n * f_n.transpose(), history: () };
-        let (push, literal) = check_spatial(&law, &delta_f, &f_n, &state).unwrap();
+        let SpatialErrors { push_forward: push, cauchy_derivative: literal } =
+            check_spatial(&law, &delta_f, &f_n, &state, STEP).unwrap().unwrap();
         prop_assert!(push <= TOL, "push-forward relative error {push:e}");
         prop_assert!(literal <= TOL, "(dσ/dF)F relative error {literal:e}");
     }
@@ -186,9 +130,9 @@ proptest! {
     ) {
         let law = von_mises_for(1e4, nu, fraction, hardening_ratio, &delta_f, &be_n, 0.0);
         let state = MaterialState { be: be_n, history: VonMisesHistory::default() };
-        let errs = check_spatial(&law, &delta_f, &f_n, &state);
+        let errs = check_spatial(&law, &delta_f, &f_n, &state, STEP).unwrap();
         prop_assume!(errs.is_some(), "stencil crosses the yield surface");
-        let (push, literal) = errs.unwrap();
+        let SpatialErrors { push_forward: push, cauchy_derivative: literal } = errs.unwrap();
         prop_assert!(push <= TOL, "push-forward relative error {push:e}");
         prop_assert!(literal <= TOL, "(dσ/dF)F relative error {literal:e}");
     }
@@ -202,7 +146,7 @@ proptest! {
     ) {
         // ε^tr = ½ ln(F Fᵀ): a random symmetric strain with the same
         // eigenvalue structure as the kinematics produce.
-        let eps = SymSpectral::new(&(strain_f * strain_f.transpose())).unwrap().log().unwrap() * 0.5;
+        let eps = hencky_strain(&strain_f).unwrap();
         let elastic = HenckyElastic::new(1e4, nu).unwrap();
         let (tau_e, _) = elastic.kirchhoff_stress(&eps, &()).unwrap();
         let s_norm = (tau_e - tau_e.trace() / 3.0 * Matrix3::identity()).norm();
@@ -211,23 +155,15 @@ proptest! {
         let history = VonMisesHistory::default();
         let trial = SymSpectral::new(&eps).unwrap();
         let state = law.return_map(&trial, &history);
-        let d = law.algorithmic_tangent(&trial, &history, &state);
         let h = STEP * plastic_scale(&trial.values, state.yielded);
-        let fd = jacobian(
-            |de| {
-                let (tau, s) = law.kirchhoff_stress(&(eps + de), &history).unwrap();
-                (s.yielded == state.yielded).then_some(tau)
-            },
-            sym_unit,
-            h,
-        );
-        prop_assume!(fd.is_some(), "stencil crosses the yield surface");
-        let err = rel(&d, &fd.unwrap());
+        let err = check_algorithmic_tangent(&law, &eps, &history, STEP).unwrap();
+        prop_assume!(err.is_some(), "stencil crosses the yield surface");
+        let err = err.unwrap();
         prop_assert!(err <= TOL, "D_alg relative error {err:e} (yielded: {})", state.yielded);
         // Hencky: D^e exactly.
         let d_e = elastic.algorithmic_tangent(&trial, &(), &elastic.return_map(&trial, &()));
         let fd_e = jacobian(|de| Some(elastic.kirchhoff(&(eps + de))), sym_unit, h).unwrap();
-        prop_assert!(rel(&d_e, &fd_e) <= TOL);
+        prop_assert!(relative_error(&d_e, &fd_e) <= TOL);
     }
 
     #[test]
@@ -237,7 +173,7 @@ proptest! {
         let l = s.dlog().unwrap();
         let h = STEP * s.min_value();
         let fd = jacobian(|db| SymSpectral::new(&(b + db)).unwrap().log().ok(), sym_unit, h).unwrap();
-        let err = rel(&l, &fd);
+        let err = relative_error(&l, &fd);
         prop_assert!(err <= TOL, "L relative error {err:e}");
     }
 
@@ -261,7 +197,7 @@ proptest! {
         let a = PreviouslyConvergedTangent::tangent(&law, &r).unwrap();
         let aq = PreviouslyConvergedTangent::tangent(&law, &rq).unwrap();
         let qa = rotate_first_and_third(&a, &q);
-        prop_assert!(rel(&aq, &qa) <= 1e-9);
+        prop_assert!(relative_error(&aq, &qa) <= 1e-9);
     }
 }
 
