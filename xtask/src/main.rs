@@ -17,12 +17,18 @@
 //! - `column-table`: error and solver time of the column for standard MPM
 //!   and GIMP (eq. 34), written to `docs/src/benchmarks/column.md`
 //!   ([`column_table`]).
+//! - `reference-values`: reruns the cases of `mpm-cases` with the settings
+//!   of its tests and writes the committed regression values
+//!   `crates/mpm-cases/tests/reference_values/*.json` (column, cantilever,
+//!   collapse, annulus, stretch), which
+//!   `crates/mpm-cases/tests/regression.rs` checks ([`reference_values`]).
 
 mod column_table;
 mod coombs2020;
 mod machine;
 mod markdown;
 mod plot;
+mod reference_values;
 mod wang2021;
 
 use std::path::{Path, PathBuf};
@@ -46,6 +52,10 @@ tasks:
                 docs/src/reproduction/wang2021.md. --full adds 16 subdivisions.
   column-table  error and run time of the column case, written to
                 docs/src/benchmarks/column.md
+  reference-values
+                reruns the cases with the settings of the tests and writes the
+                committed regression values crates/mpm-cases/tests/reference_values/
+                (*.json, one per case) that tests/regression.rs compares against
   help          this message";
 
 fn main() -> Result<()> {
@@ -58,6 +68,10 @@ fn main() -> Result<()> {
         Some("column-table") => {
             no_more_arguments(&args[1..])?;
             column_table::run(&docs_dir())
+        }
+        Some("reference-values") => {
+            no_more_arguments(&args[1..])?;
+            reference_values::run(&workspace_dir())
         }
         Some("reproduce") => match args.get(1).map(String::as_str) {
             Some("coombs2020") => {
@@ -92,6 +106,11 @@ fn no_more_arguments(rest: &[String]) -> Result<()> {
 /// The mdBook sources, `docs/src` of the workspace.
 fn docs_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/src")
+}
+
+/// The workspace root.
+fn workspace_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
 /// Writes `contents` to `path`, creating its folder.

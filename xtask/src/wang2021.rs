@@ -21,7 +21,7 @@ use crate::{machine, write_file};
 
 /// Table 1: subdivisions along x and z and the paper's normalised
 /// Kirchhoff stress error, F-patch and standard MPM.
-const TABLE_1: [(usize, f64, f64); 4] = [
+pub(crate) const TABLE_1: [(usize, f64, f64); 4] = [
     (2, 3.35e-2, 5.54e-2),
     (4, 5.69e-3, 8.03e-3),
     (8, 1.10e-3, 1.56e-3),
