@@ -24,6 +24,17 @@ pub trait BasisFunction<const D: usize>: Send + Sync {
     type Domain: Copy + Send + Sync + Debug;
     /// Largest number of supporting nodes of one point.
     const MAX_NODES: usize;
+    /// Cells of padding the basis needs between a body and a grid boundary
+    /// (the B-spline stencil must stay inside the grid).
+    const PADDING: usize = 0;
+    /// Half-width of a point's support in cells, per axis (an upper bound
+    /// for domain-based bases with domains of at most half a cell).
+    const SUPPORT_RADIUS: f64 = 1.0;
+
+    /// The undeformed domain of a point at `position` that represents the
+    /// box of half-lengths `half_lengths` around it (`()` for bases without
+    /// a domain).
+    fn initial_domain(position: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> Self::Domain;
 
     /// Clear `out` and write the node ids, values and gradients of the point
     /// at `position` with domain `domain`.

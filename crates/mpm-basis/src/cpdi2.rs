@@ -172,6 +172,12 @@ impl<const D: usize> BasisFunction<D> for Cpdi2 {
     /// Each corner touches the $2^D$ nodes of its cell: at most $4^D$
     /// distinct nodes.
     const MAX_NODES: usize = 1 << (2 * D);
+    const SUPPORT_RADIUS: f64 = 1.5;
+
+    /// The rectangle of half-lengths `half_lengths` around the point.
+    fn initial_domain(position: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> Corners<D> {
+        Corners::rectangle(position, half_lengths)
+    }
 
     fn evaluate(
         &self,

@@ -97,6 +97,12 @@ impl<const D: usize> BasisFunction<D> for Gimp {
     /// $\lambda \le 1/2$: the support $|\delta| < 1 + \lambda$ is an open
     /// interval of length at most three cells.
     const MAX_NODES: usize = 3usize.pow(D as u32);
+    const SUPPORT_RADIUS: f64 = 1.5;
+
+    /// The half-lengths themselves.
+    fn initial_domain(_: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> SVector<f64, D> {
+        *half_lengths
+    }
 
     fn evaluate(
         &self,

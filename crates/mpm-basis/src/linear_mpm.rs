@@ -35,6 +35,8 @@ impl<const D: usize> BasisFunction<D> for LinearMpm {
     type Domain = ();
     const MAX_NODES: usize = 1 << D;
 
+    fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
+
     fn evaluate(
         &self,
         mesh: &RegularGrid<D>,

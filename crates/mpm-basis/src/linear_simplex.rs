@@ -37,6 +37,8 @@ impl<const D: usize> BasisFunction<D> for LinearSimplex {
     type Domain = ();
     const MAX_NODES: usize = D + 1;
 
+    fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
+
     fn evaluate(
         &self,
         mesh: &SimplexMesh<D>,

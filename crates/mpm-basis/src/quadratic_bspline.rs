@@ -57,6 +57,10 @@ impl<const D: usize> BasisFunction<D> for QuadraticBSpline {
     type Mesh = RegularGrid<D>;
     type Domain = ();
     const MAX_NODES: usize = 3usize.pow(D as u32);
+    const PADDING: usize = 1;
+    const SUPPORT_RADIUS: f64 = 1.5;
+
+    fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
 
     fn evaluate(
         &self,

@@ -1,6 +1,6 @@
 //! Material point bodies filling rectangular (box) regions of a grid.
 
-use mpm_basis::{BasisFunction, Corners, Cpdi2, Gimp, LinearMpm, LinearSimplex, QuadraticBSpline};
+use mpm_basis::BasisFunction;
 use mpm_mesh::{RegularGrid, SimplexMesh};
 use nalgebra::SVector;
 
@@ -194,49 +194,11 @@ fn subdivision_centroids<const D: usize>(n: usize) -> Vec<([f64; 4], f64)> {
     out
 }
 
-/// How a basis builds the initial domain of a point from its position and
-/// half-lengths.
-pub trait InitialDomain<const D: usize>: BasisFunction<D> {
-    /// Cells of padding the basis needs between the body and a grid
-    /// boundary (the B-spline stencil must stay inside the grid).
-    const PADDING: usize = 0;
+/// A basis as the cases use it: every [`BasisFunction`] (whose
+/// `initial_domain`, `PADDING` and `SUPPORT_RADIUS` place its points).
+pub trait InitialDomain<const D: usize>: BasisFunction<D> {}
 
-    /// Half-width of a point's support in cells, per axis (an upper bound
-    /// for domain-based bases with domains of at most half a cell).
-    const SUPPORT_RADIUS: f64 = 1.0;
-
-    /// The undeformed domain.
-    fn initial_domain(position: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> Self::Domain;
-}
-
-impl<const D: usize> InitialDomain<D> for LinearSimplex {
-    fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
-}
-
-impl<const D: usize> InitialDomain<D> for LinearMpm {
-    fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
-}
-
-impl<const D: usize> InitialDomain<D> for QuadraticBSpline {
-    const PADDING: usize = 1;
-    const SUPPORT_RADIUS: f64 = 1.5;
-
-    fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
-}
-
-impl<const D: usize> InitialDomain<D> for Gimp {
-    const SUPPORT_RADIUS: f64 = 1.5;
-    fn initial_domain(_: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> SVector<f64, D> {
-        *half_lengths
-    }
-}
-
-impl<const D: usize> InitialDomain<D> for Cpdi2 {
-    const SUPPORT_RADIUS: f64 = 1.5;
-    fn initial_domain(position: &SVector<f64, D>, half_lengths: &SVector<f64, D>) -> Corners<D> {
-        Corners::rectangle(position, half_lengths)
-    }
-}
+impl<const D: usize, B: BasisFunction<D>> InitialDomain<D> for B {}
 
 #[cfg(test)]
 mod tests {

@@ -11,6 +11,7 @@ pub mod body;
 pub mod cases;
 pub mod checkpoint;
 pub mod error;
+pub mod material;
 pub mod output;
 pub mod params;
 pub mod run;

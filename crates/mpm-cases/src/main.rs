@@ -20,7 +20,7 @@ use mpm_cases::run::{RunControl, Snapshot};
 use mpm_cases::scene_file::parse_scene;
 use mpm_cases::variant::{BasisKind, Variant};
 use mpm_cases::writer::{RunWriter, Summary};
-use mpm_solver::{SolverError, StepReport};
+use mpm_solver::{ObserverError, SolverError, StepReport};
 use serde::Serialize;
 use serde_json::{Map, Value, json};
 
@@ -329,8 +329,7 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
                 .set_position((report.lambda1 * 1000.0).round() as u64);
             self.bar.set_message(line);
         }
-        let io =
-            |e: mpm_cases::CasesError| SolverError::InvalidInput(format!("writing output: {e}"));
+        let io = |e: mpm_cases::CasesError| SolverError::Observer(ObserverError::new(e));
         self.writer.step(step, report, snap).map_err(io)?;
         if let Some(c) = &snap.checkpoint {
             checkpoint::write(
@@ -453,7 +452,7 @@ fn cantilever_run(p: &cantilever::CantileverParams, run: &Run) -> Result<()> {
                     (uy / p.length).into(),
                 ],
             )
-            .map_err(|e| SolverError::InvalidInput(format!("writing output: {e}")))?;
+            .map_err(|e| SolverError::Observer(ObserverError::new(e)))?;
         obs.step(s, rep, snap)
     })?;
     let mut results = Map::new();

@@ -2,9 +2,6 @@
 //! domain update — chosen at run time by name and dispatched to a fully
 //! monomorphised solver.
 
-use std::fmt;
-use std::str::FromStr;
-
 use mpm_basis::{Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
@@ -12,6 +9,7 @@ use mpm_solver::{
     IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, PreviouslyConverged, StretchU,
     UpdatedLagrangian, VolumeCorrectedDiagF,
 };
+use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
 use crate::body::InitialDomain;
@@ -20,7 +18,7 @@ use crate::run::DomainBounds;
 macro_rules! named_enum {
     ($(#[$doc:meta])* $name:ident { $($(#[$vdoc:meta])* $variant:ident => $text:literal),+ $(,)? }) => {
         $(#[$doc])*
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
         pub enum $name {
             $($(#[$vdoc])* #[serde(rename = $text)] $variant),+
         }
@@ -35,13 +33,13 @@ macro_rules! named_enum {
             }
         }
 
-        impl fmt::Display for $name {
-            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        impl ::std::fmt::Display for $name {
+            fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
                 f.write_str(self.name())
             }
         }
 
-        impl FromStr for $name {
+        impl ::std::str::FromStr for $name {
             type Err = String;
             fn from_str(s: &str) -> Result<Self, String> {
                 match s {
@@ -56,20 +54,42 @@ macro_rules! named_enum {
         }
     };
 }
+pub(crate) use named_enum;
 
-named_enum!(
-    /// Basis functions (mpm-basis).
-    BasisKind {
-        /// Standard MPM (bi/trilinear).
-        Linear => "linear",
-        /// Uniform GIMP.
-        Gimp => "gimp",
-        /// CPDI2.
-        Cpdi2 => "cpdi2",
-        /// Quadratic B-spline.
-        BSpline2 => "bspline2",
-    }
-);
+/// The bases reachable from scene files and the command line, one line
+/// each: the variant, its name, the `mpm_basis` type, and the family of
+/// domain rules it takes (`point`: none, `gimp`: every GIMP rule,
+/// `cpdi2`: corners convected with the grid). A new basis is one file in
+/// `mpm-basis` and one line here.
+macro_rules! register_bases {
+    ($($(#[$doc:meta])* $variant:ident => $text:literal, $ty:ty, $family:ident;)+) => {
+        named_enum!(
+            /// Basis functions (mpm-basis).
+            BasisKind { $($(#[$doc])* $variant => $text),+ }
+        );
+
+        /// Calls `visitor` with the basis named by `variant.basis`.
+        fn dispatch_basis<const D: usize, V: VariantVisitor<D>>(
+            variant: &Variant,
+            visitor: V,
+        ) -> Result<V::Output, String> {
+            match variant.basis {
+                $(BasisKind::$variant => $family::<D, V, $ty>(variant, visitor, <$ty>::default()),)+
+            }
+        }
+    };
+}
+
+register_bases! {
+    /// Standard MPM (bi/trilinear).
+    Linear => "linear", LinearMpm, point;
+    /// Uniform GIMP.
+    Gimp => "gimp", Gimp, gimp;
+    /// CPDI2.
+    Cpdi2 => "cpdi2", Cpdi2, cpdi2;
+    /// Quadratic B-spline.
+    BSpline2 => "bspline2", QuadraticBSpline, point;
+}
 
 named_enum!(
     /// Statement of equilibrium (Coombs 2020 §3, §5).
@@ -217,93 +237,112 @@ pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
     variant: &Variant,
     visitor: V,
 ) -> Result<V::Output, String> {
-    fn with_formulation<const D: usize, V, B, U>(
-        f: FormulationKind,
-        v: V,
-        basis: B,
-        updater: U,
-    ) -> V::Output
-    where
-        V: VariantVisitor<D>,
-        B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>,
-        U: DomainUpdater<D, B::Domain>,
-    {
-        match f {
-            FormulationKind::Ul => v.visit::<B, UpdatedLagrangian, U>(basis, updater),
-            FormulationKind::Pc => v.visit::<B, PreviouslyConverged, U>(basis, updater),
-        }
-    }
-    let f = variant.formulation;
     if variant.basis != BasisKind::Gimp && variant.gimp_volume != GimpVolumeKind::DetF {
         return Err(format!(
             "gimp_volume = {} applies to basis = gimp",
             variant.gimp_volume
         ));
     }
-    let no_domain = |name: &str| {
-        if variant.domain_update == DomainUpdateKind::None {
-            Ok(())
-        } else {
-            Err(format!(
-                "domain_update = {} needs basis = gimp ({name} has no domain to update)",
-                variant.domain_update
-            ))
-        }
-    };
-    match variant.basis {
-        BasisKind::Linear => {
-            no_domain("linear")?;
-            Ok(with_formulation(f, visitor, LinearMpm, NoUpdate))
-        }
-        BasisKind::BSpline2 => {
-            no_domain("bspline2")?;
-            Ok(with_formulation(f, visitor, QuadraticBSpline, NoUpdate))
-        }
-        BasisKind::Cpdi2 => match variant.domain_update {
-            DomainUpdateKind::None | DomainUpdateKind::Cpdi2 => {
-                Ok(with_formulation(f, visitor, Cpdi2, ConvectedCorners))
-            }
-            other => Err(format!(
-                "basis = cpdi2 convects its corners with the grid; domain_update = {other} applies to gimp only"
-            )),
-        },
-        BasisKind::Gimp => {
-            // The rules, each wrapped by `$wrap` (the identity, or the
-            // domain's volume as the points' integration volume).
-            macro_rules! rules {
-                ($wrap:expr) => {
-                    match variant.domain_update {
-                        DomainUpdateKind::None => with_formulation(f, visitor, Gimp, $wrap(NoUpdate)),
-                        DomainUpdateKind::DetF => with_formulation(f, visitor, Gimp, $wrap(DetF)),
-                        DomainUpdateKind::DiagF => with_formulation(f, visitor, Gimp, $wrap(DiagF)),
-                        DomainUpdateKind::Stretch => {
-                            with_formulation(f, visitor, Gimp, $wrap(StretchU))
-                        }
-                        DomainUpdateKind::CornerMidpoint => {
-                            with_formulation(f, visitor, Gimp, $wrap(CornerMidpoint))
-                        }
-                        DomainUpdateKind::Midpoint => {
-                            with_formulation(f, visitor, Gimp, $wrap(Midpoint))
-                        }
-                        DomainUpdateKind::VolumeCorrectedDiagF => {
-                            with_formulation(f, visitor, Gimp, $wrap(VolumeCorrectedDiagF))
-                        }
-                        DomainUpdateKind::IncrementalVolumeCorrectedDiagF => with_formulation(
-                            f,
-                            visitor,
-                            Gimp,
-                            $wrap(IncrementalVolumeCorrectedDiagF),
-                        ),
-                        DomainUpdateKind::Cpdi2 => {
-                            return Err("domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2".into());
-                        }
-                    }
-                };
-            }
-            Ok(match variant.gimp_volume {
-                GimpVolumeKind::DetF => rules!(std::convert::identity),
-                GimpVolumeKind::Domain => rules!(DomainVolume),
-            })
-        }
+    dispatch_basis(variant, visitor)
+}
+
+/// The basis `B` with formulation `variant.formulation` and updater `U`.
+fn with_formulation<const D: usize, V, B, U>(
+    variant: &Variant,
+    v: V,
+    basis: B,
+    updater: U,
+) -> V::Output
+where
+    V: VariantVisitor<D>,
+    B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>,
+    U: DomainUpdater<D, B::Domain>,
+{
+    match variant.formulation {
+        FormulationKind::Ul => v.visit::<B, UpdatedLagrangian, U>(basis, updater),
+        FormulationKind::Pc => v.visit::<B, PreviouslyConverged, U>(basis, updater),
     }
+}
+
+/// A basis without a domain: no domain rule applies.
+fn point<const D: usize, V, B>(variant: &Variant, visitor: V, basis: B) -> Result<V::Output, String>
+where
+    V: VariantVisitor<D>,
+    B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>,
+{
+    if variant.domain_update != DomainUpdateKind::None {
+        return Err(format!(
+            "domain_update = {} needs basis = gimp ({} has no domain to update)",
+            variant.domain_update, variant.basis
+        ));
+    }
+    Ok(with_formulation(variant, visitor, basis, NoUpdate))
+}
+
+/// CPDI2's corners are convected with the grid (eq. 35 form).
+fn cpdi2<const D: usize, V, B>(variant: &Variant, visitor: V, basis: B) -> Result<V::Output, String>
+where
+    V: VariantVisitor<D>,
+    B: InitialDomain<D, Mesh = RegularGrid<D>, Domain = mpm_basis::Corners<D>>,
+    B::Domain: Flat + DomainBounds<D>,
+{
+    match variant.domain_update {
+        DomainUpdateKind::None | DomainUpdateKind::Cpdi2 => {
+            Ok(with_formulation(variant, visitor, basis, ConvectedCorners))
+        }
+        other => Err(format!(
+            "basis = cpdi2 convects its corners with the grid; domain_update = {other} applies to gimp only"
+        )),
+    }
+}
+
+/// GIMP with every domain rule of Coombs et al. 2020 §6.4, each optionally
+/// integrating with the domain's volume.
+fn gimp<const D: usize, V, B>(variant: &Variant, visitor: V, basis: B) -> Result<V::Output, String>
+where
+    V: VariantVisitor<D>,
+    B: InitialDomain<D, Mesh = RegularGrid<D>, Domain = SVector<f64, D>>,
+    B::Domain: Flat + DomainBounds<D>,
+{
+    // The rules, each wrapped by `$wrap` (the identity, or the domain's
+    // volume as the points' integration volume).
+    macro_rules! rules {
+        ($wrap:expr) => {
+            match variant.domain_update {
+                DomainUpdateKind::None => {
+                    with_formulation(variant, visitor, basis, $wrap(NoUpdate))
+                }
+                DomainUpdateKind::DetF => with_formulation(variant, visitor, basis, $wrap(DetF)),
+                DomainUpdateKind::DiagF => with_formulation(variant, visitor, basis, $wrap(DiagF)),
+                DomainUpdateKind::Stretch => {
+                    with_formulation(variant, visitor, basis, $wrap(StretchU))
+                }
+                DomainUpdateKind::CornerMidpoint => {
+                    with_formulation(variant, visitor, basis, $wrap(CornerMidpoint))
+                }
+                DomainUpdateKind::Midpoint => {
+                    with_formulation(variant, visitor, basis, $wrap(Midpoint))
+                }
+                DomainUpdateKind::VolumeCorrectedDiagF => {
+                    with_formulation(variant, visitor, basis, $wrap(VolumeCorrectedDiagF))
+                }
+                DomainUpdateKind::IncrementalVolumeCorrectedDiagF => with_formulation(
+                    variant,
+                    visitor,
+                    basis,
+                    $wrap(IncrementalVolumeCorrectedDiagF),
+                ),
+                DomainUpdateKind::Cpdi2 => {
+                    return Err(
+                        "domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2"
+                            .into(),
+                    );
+                }
+            }
+        };
+    }
+    Ok(match variant.gimp_volume {
+        GimpVolumeKind::DetF => rules!(std::convert::identity),
+        GimpVolumeKind::Domain => rules!(DomainVolume),
+    })
 }

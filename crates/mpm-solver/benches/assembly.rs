@@ -11,7 +11,7 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use mpm_basis::{BasisFunction, Corners, Cpdi2, Gimp, LinearMpm};
+use mpm_basis::{BasisFunction, Cpdi2, Gimp, LinearMpm};
 use mpm_constitutive::HenckyElastic;
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
@@ -30,29 +30,10 @@ type Prepared<const D: usize, B, F, U> = (
     Vec<f64>,
 );
 
-/// A basis with the initial domain of a point from its position and
-/// half-lengths.
-trait BenchBasis<const D: usize>: BasisFunction<D, Mesh = RegularGrid<D>> {
-    /// The undeformed domain of a point at `position` with half-lengths
-    /// `half`.
-    fn domain(position: &SVector<f64, D>, half: &SVector<f64, D>) -> Self::Domain;
-}
+/// The bases of the benchmark: those on regular grids.
+trait BenchBasis<const D: usize>: BasisFunction<D, Mesh = RegularGrid<D>> {}
 
-impl<const D: usize> BenchBasis<D> for LinearMpm {
-    fn domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
-}
-
-impl<const D: usize> BenchBasis<D> for Gimp {
-    fn domain(_: &SVector<f64, D>, half: &SVector<f64, D>) -> SVector<f64, D> {
-        *half
-    }
-}
-
-impl<const D: usize> BenchBasis<D> for Cpdi2 {
-    fn domain(position: &SVector<f64, D>, half: &SVector<f64, D>) -> Corners<D> {
-        Corners::rectangle(position, half)
-    }
-}
+impl<const D: usize, B: BasisFunction<D, Mesh = RegularGrid<D>>> BenchBasis<D> for B {}
 
 /// A box of `cells` cells per axis filled with 2^D points per cell, base
 /// fixed, gravity; the step is prepared and one increment applied. The
@@ -91,7 +72,7 @@ where
         })
         .collect();
     let half = SVector::<f64, D>::from_element(h / 4.0);
-    let domains = pos.iter().map(|x| B::domain(x, &half)).collect();
+    let domains = pos.iter().map(|x| B::initial_domain(x, &half)).collect();
     let mut points =
         MaterialPoints::new(pos, vec![(h / 2.0).powi(D as i32); total], 1000.0, domains).unwrap();
     let mut g = SVector::<f64, D>::zeros();

@@ -146,7 +146,7 @@ pub enum SolverError {
     Pattern(#[source] LinearSolveError),
     /// The observer of a run (output, progress) failed; the state after the
     /// last converged step is intact.
-    #[error("after a converged step: {0}")]
+    #[error("output or observer after a converged step: {0}")]
     Observer(#[source] ObserverError),
 }
 

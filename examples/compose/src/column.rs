@@ -32,10 +32,9 @@ pub struct ColumnState {
     pub top: f64,
 }
 
-/// Runs the column with any basis (its initial domain from the points'
-/// half-lengths by `domain`), formulation, law and domain rule.
+/// Runs the column with any basis, formulation, law and domain rule.
 pub fn run_column<B, F, L, U>(
-    (basis, domain): (B, fn(Vector2<f64>) -> B::Domain),
+    basis: B,
     formulation: F,
     law: L,
     updater: U,
@@ -61,7 +60,10 @@ where
         .map(|k| Vector2::new((k % nx) as f64 + 0.5, (k / nx) as f64 + 0.5).component_mul(&step))
         .collect();
     let n = position.len();
-    let domains = vec![domain(step / 2.0); n];
+    let domains = position
+        .iter()
+        .map(|x| B::initial_domain(x, &(step / 2.0)))
+        .collect();
     let mut points: MaterialPoints<2, L::History, B::Domain> =
         MaterialPoints::new(position, vec![step.product(); n], density, domains)?;
     points.set_gravity(Vector2::new(0.0, -gravity));
@@ -75,12 +77,20 @@ where
             ..NewtonOptions::default()
         })
         .build();
-    solver.run(&mut points, &LoadStepping::uniform(s.load_steps), |_, _, _| Ok(()))?;
+    solver.run(
+        &mut points,
+        &LoadStepping::uniform(s.load_steps),
+        |_, _, _| Ok(()),
+    )?;
     Ok(ColumnState {
         points: (0..n)
             .map(|p| (points.sigma[p][(1, 1)], z0[p], points.volume0[p]))
             .collect(),
-        top: points.position.iter().map(|x| x[1]).fold(f64::MIN, f64::max),
+        top: points
+            .position
+            .iter()
+            .map(|x| x[1])
+            .fold(f64::MIN, f64::max),
     })
 }
 

@@ -20,6 +20,8 @@ impl<const D: usize> DeformationRule<D> for FibreLength {
         if !(det.is_finite() && det > 0.0) {
             return Err(DomainError::NonPositiveJacobian { name: "F", det });
         }
-        Ok(SVector::from_fn(|i, _| ctx.initial[i] * ctx.f.column(i).norm()))
+        Ok(SVector::from_fn(|i, _| {
+            ctx.initial[i] * ctx.f.column(i).norm()
+        }))
     }
 }

@@ -1,7 +1,9 @@
 //! A constitutive law written outside the framework.
 
 use mpm_constitutive::tensor::{Tensor4, dyad, sym_identity};
-use mpm_constitutive::{ConstitutiveError, IsotropicElasticity, LawState, LogStrainLaw, SymSpectral};
+use mpm_constitutive::{
+    ConstitutiveError, IsotropicElasticity, LawState, LogStrainLaw, SymSpectral,
+};
 use nalgebra::{Matrix3, Vector3};
 
 /// Hencky elasticity with a shear modulus that grows with the deviatoric
@@ -10,10 +12,9 @@ use nalgebra::{Matrix3, Vector3};
 /// gives the Kirchhoff stress
 /// $\tau = K\operatorname{tr}\varepsilon\,\mathbf 1 + 2\mu_0(1 + \beta\,e:e)\,e$
 /// and the (symmetric) tangent
-/// $D = K\,\mathbf 1\otimes\mathbf 1 + 2\mu_0(1 + \beta\,e:e)\,\mathbb I^{dev}
-/// + 4\mu_0\beta\,e\otimes e$, with $\mathbb I^{dev} = \mathbb I^s -
-/// \tfrac13\mathbf 1\otimes\mathbf 1$. With $\beta = 0$ it is the
-/// framework's `HenckyElastic`.
+/// $D = K\,\mathbf 1\otimes\mathbf 1 + 2\mu_0(1 + \beta\,e:e)\,\mathbb I^{dev} + 4\mu_0\beta\,e\otimes e$,
+/// with $\mathbb I^{dev} = \mathbb I^s - \tfrac13\mathbf 1\otimes\mathbf 1$.
+/// With $\beta = 0$ it is the framework's `HenckyElastic`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StiffeningHencky {
     elasticity: IsotropicElasticity,

@@ -187,7 +187,7 @@ pub struct AnnulusResult {
 
 /// The background mesh: generated, or read from `p.mesh`.
 pub fn mesh(p: &AnnulusParams) -> Result<SimplexMesh<2>, SolverError> {
-    let invalid = |e: mpm_mesh::MeshError| SolverError::InvalidInput(e.to_string());
+    let invalid = SolverError::from;
     if let Some(path) = &p.mesh {
         return match read_msh::<2>(path).map_err(invalid)?.elements {
             GmshElements::Linear(mesh) => Ok(mesh),
@@ -252,8 +252,7 @@ where
         constraints.fix(nodes.iter().copied(), 0);
         constraints.fix(nodes.iter().copied(), 1);
     }
-    let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio)
-        .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+    let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio).map_err(SolverError::from)?;
     let torsion = Torsion {
         inner_radius: p.inner_radius,
         outer_radius: p.outer_radius,

@@ -91,7 +91,7 @@ pub fn geometry(
             ((below + p.depth + 0.5) / p.h).ceil() as usize + 2 * pad,
         ],
     )
-    .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+    .map_err(SolverError::from)?;
     let body = Body::fill_box(
         &grid,
         &SVector::<f64, 2>::zeros(),
@@ -101,9 +101,7 @@ pub fn geometry(
     let mut constraints = NodalConstraints::<2>::new(grid.node_count());
     let tol = 1e-9 * p.h;
     for n in 0..grid.node_count() {
-        let x = grid
-            .node_position(n)
-            .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+        let x = grid.node_position(n).map_err(SolverError::from)?;
         // The root is a wall: every grid node on it is on a roller (CPDI2
         // and GIMP corners near the root then stay on it), the neutral
         // axis is pinned.
@@ -155,8 +153,8 @@ where
     {
         let p = self.params;
         let (grid, body, constraints, loaded) = geometry(p, B::PADDING)?;
-        let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio)
-            .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+        let law =
+            HenckyElastic::new(p.youngs_modulus, p.poisson_ratio).map_err(SolverError::from)?;
         let force = SVector::<f64, 2>::new(0.0, -p.load / 2.0);
         let setup = Setup {
             grid,

@@ -96,7 +96,7 @@ pub fn geometry(
         SVector::<f64, 2>::new(p.h, p.h),
         [nx + 2 * pad, ny + 1 + 2 * pad],
     )
-    .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+    .map_err(SolverError::from)?;
     let body = Body::fill_box(
         &grid,
         &SVector::<f64, 2>::zeros(),
@@ -106,9 +106,7 @@ pub fn geometry(
     let mut constraints = NodalConstraints::<2>::new(grid.node_count());
     let tol = 1e-9 * p.h;
     for n in 0..grid.node_count() {
-        let x = grid
-            .node_position(n)
-            .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+        let x = grid.node_position(n).map_err(SolverError::from)?;
         if x[0] <= tol {
             constraints.fix([n], 0);
         }
@@ -140,7 +138,7 @@ where
         let p = self.params;
         let (grid, body, constraints) = geometry(p, B::PADDING)?;
         let law = VonMises::new(p.youngs_modulus, p.poisson_ratio, p.yield_stress, 0.0)
-            .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+            .map_err(SolverError::from)?;
         // The body force is applied as m_p g with unit density.
         let setup = Setup {
             grid,

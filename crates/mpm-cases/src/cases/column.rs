@@ -8,7 +8,9 @@
 //! $Z$ the initial height) and the error norm (eq. 42)
 //! $\sum_p |\sigma_{zz,p} - \sigma^a_{zz}(Z_p)| V^0_p / (\varrho_0 g l_0 V_0)$.
 
-use mpm_constitutive::HenckyElastic;
+use std::marker::PhantomData;
+
+use mpm_constitutive::LogStrainLaw;
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
     DomainUpdater, Flat, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
@@ -16,7 +18,10 @@ use mpm_solver::{
 use nalgebra::SVector;
 
 use crate::body::{Body, InitialDomain};
-use crate::run::{DomainBounds, Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
+use crate::material::{LawVisitor, MaterialModel, MaterialParams, dispatch_law};
+use crate::run::{
+    DomainBounds, HistoryOutput, Loads, RunControl, RunOutput, Setup, Snapshot, simulate,
+};
 use crate::variant::{Variant, VariantVisitor, dispatch};
 
 crate::case_params! {
@@ -40,6 +45,12 @@ crate::case_params! {
         pub load_steps: usize = 20,
         /// Newton tolerance on eq. (40).
         pub tolerance: f64 = 1e-9,
+        /// Constitutive model (the paper's: Hencky elasticity).
+        pub material: MaterialModel = MaterialModel::Hencky,
+        /// Yield stress ρ_y (Pa) for plastic models.
+        pub yield_stress: Option<f64> = None,
+        /// Linear hardening modulus (Pa) for plastic models.
+        pub hardening: f64 = 0.0,
     }
 }
 
@@ -95,7 +106,7 @@ pub fn geometry(
         SVector::<f64, 2>::new(p.h, p.h),
         [1 + 2 * pad, cells_y + 2 * pad],
     )
-    .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+    .map_err(SolverError::from)?;
     let body = Body::fill_box(
         &grid,
         &SVector::<f64, 2>::zeros(),
@@ -136,9 +147,50 @@ where
         U: DomainUpdater<2, B::Domain>,
     {
         let p = self.params;
+        let material = MaterialParams {
+            youngs_modulus: p.youngs_modulus,
+            poisson_ratio: p.poisson_ratio,
+            yield_stress: p.yield_stress,
+            hardening: p.hardening,
+        };
+        dispatch_law(
+            p.material,
+            &material,
+            WithLaw::<B, F, U, O> {
+                run: self,
+                basis,
+                updater,
+                formulation: PhantomData,
+            },
+        )?
+    }
+}
+
+/// The column with basis `B`, formulation `F`, updater `U` and the law
+/// the scene names.
+struct WithLaw<'a, B, F, U, O> {
+    run: ColumnRun<'a, O>,
+    basis: B,
+    updater: U,
+    formulation: PhantomData<F>,
+}
+
+impl<B, F, U, O> LawVisitor for WithLaw<'_, B, F, U, O>
+where
+    B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
+    F: Formulation,
+    U: DomainUpdater<2, B::Domain>,
+    O: FnMut(usize, &mpm_solver::StepReport<2>, &Snapshot) -> Result<(), SolverError>,
+{
+    type Output = Result<ColumnResult, SolverError>;
+
+    fn visit<L>(self, law: L) -> Self::Output
+    where
+        L: LogStrainLaw,
+        L::History: HistoryOutput + Flat,
+    {
+        let (p, basis, updater) = (self.run.params, self.basis, self.updater);
         let (grid, body, constraints) = geometry(p, B::PADDING)?;
-        let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio)
-            .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
         let setup = Setup {
             grid,
             body: &body,
@@ -156,8 +208,13 @@ where
                 ..NewtonOptions::default()
             },
         };
-        let output =
-            simulate::<2, B, F, U, _, _, _>(setup, basis, updater, self.control, self.observer)?;
+        let output = simulate::<2, B, F, U, _, _, _>(
+            setup,
+            basis,
+            updater,
+            self.run.control,
+            self.run.observer,
+        )?;
         let z0: Vec<f64> = body.position.iter().map(|x| x[1]).collect();
         let error = p.error(&output.last, &z0, &body.volume);
         Ok(ColumnResult {

@@ -178,8 +178,7 @@ impl<L: LogStrainLaw> SinglePoint<L> {
     /// Applies the shear increment `dgamma` and returns the Cauchy stress.
     pub fn shear(&mut self, dgamma: f64) -> Result<Matrix3<f64>, SolverError> {
         let df = embed(&Matrix2::new(1.0, dgamma, 0.0, 1.0));
-        let r = update(&self.law, &df, &self.f, &self.state)
-            .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+        let r = update(&self.law, &df, &self.f, &self.state).map_err(SolverError::from)?;
         self.f = r.f;
         self.state = r.state;
         Ok(r.sigma)
@@ -221,7 +220,7 @@ pub fn grid(p: &ShearParams, pad: usize) -> Result<RegularGrid<2>, SolverError> 
         SVector::<f64, 2>::new(p.h, p.h),
         [nx + 1 + 2 * pad, cells as usize + 2 * pad],
     )
-    .map_err(|e| SolverError::InvalidInput(e.to_string()))
+    .map_err(SolverError::from)
 }
 
 struct ShearRun<'a, O> {
@@ -343,16 +342,13 @@ where
         U: DomainUpdater<2, B::Domain>,
     {
         let p = self.params;
-        let invalid =
-            |e: mpm_constitutive::ConstitutiveError| SolverError::InvalidInput(e.to_string());
         match p.yield_stress {
             None => {
-                let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio).map_err(invalid)?;
+                let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio)?;
                 self.go::<B, F, U, _>(basis, updater, law)
             }
             Some(y) => {
-                let law =
-                    VonMises::new(p.youngs_modulus, p.poisson_ratio, y, 0.0).map_err(invalid)?;
+                let law = VonMises::new(p.youngs_modulus, p.poisson_ratio, y, 0.0)?;
                 self.go::<B, F, U, _>(basis, updater, law)
             }
         }

@@ -111,7 +111,7 @@ pub struct StretchResult {
 
 /// The background mesh of linear tetrahedra.
 pub fn mesh(p: &StretchParams) -> Result<SimplexMesh<3>, SolverError> {
-    let invalid = |e: mpm_mesh::MeshError| SolverError::InvalidInput(e.to_string());
+    let invalid = SolverError::from;
     let quadratic = match &p.mesh {
         Some(path) => match read_msh::<3>(path).map_err(invalid)?.elements {
             GmshElements::Linear(mesh) => return Ok(mesh),
@@ -189,7 +189,7 @@ where
         p.yield_stress,
         p.hardening,
     )
-    .map_err(|e| SolverError::InvalidInput(e.to_string()))?;
+    .map_err(SolverError::from)?;
     let elements = mesh.element_count();
     let setup = Setup {
         grid: mesh,
