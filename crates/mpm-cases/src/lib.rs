@@ -1,11 +1,27 @@
-//! Benchmark scenes of the reference papers with their analytic or
-//! published reference values.
+//! Benchmark cases of the reference papers with their analytic or
+//! published reference values, and the `mpm` command-line program.
 //!
-//! This crate will hold the cases of Coombs et al. 2020 §7 (compaction under
-//! self weight, simple shear, elastic cantilever, elastic annulus,
-//! elasto-plastic collapse) and of Wang et al. 2021, each as data selected by
-//! name or by a scene file, and the `mpm` command-line program that runs
-//! them. The program arrives with the solver.
+//! A case ([`cases`]) builds its mesh, body, loads and constraints from a
+//! parameter struct (every field a scene-file key with a default), runs the
+//! generic solver with the variant the scene names and measures its result
+//! against the reference. The variant — basis, formulation, locking
+//! treatment, domain update ([`variant`]) — and the constitutive law
+//! ([`material`]) are chosen by name at run time and dispatched to a fully
+//! monomorphised solver; each basis and law is one line of a registry
+//! (`register_bases!`, `register_laws!`). Outputs ([`output`], [`writer`])
+//! are VTU/PVD for ParaView, CSV histories and `summary.json`, written
+//! atomically; [`checkpoint`] resumes an interrupted run.
+//!
+//! ```
+//! use mpm_cases::cases::column::{self, ColumnParams};
+//! use mpm_cases::run::RunControl;
+//! use mpm_cases::variant::Variant;
+//!
+//! let params = ColumnParams { h: 12.5, ..ColumnParams::default() };
+//! let result = column::run(&params, &Variant::default(), &RunControl::default(), |_, _, _| Ok(()))?;
+//! assert!(result.error < 0.1, "eq. (42) error {}", result.error);
+//! # Ok::<(), mpm_solver::SolverError>(())
+//! ```
 
 pub mod body;
 pub mod cases;
