@@ -81,9 +81,9 @@ pub mod stepping;
 pub use boundary::{Constraints, NodalConstraints, StepView};
 pub use checkpoint::Flat;
 pub use domain::{
-    ConvectedCorners, CornerMidpoint, DeformationRule, DetF, DiagF, DomainContext, DomainError,
-    DomainUpdater, DomainVolume, GimpContext, IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate,
-    StretchU, VolumeCorrectedDiagF,
+    ConvectedCorners, CornerMidpoint, DeformationRule, DetF, DiagF, DisplacementField,
+    DomainContext, DomainError, DomainUpdater, DomainVolume, GimpContext,
+    IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, StretchU, VolumeCorrectedDiagF,
 };
 pub use error::{BasisFailure, MeshMotionError, ObserverError, SolverError, StepFailure};
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};

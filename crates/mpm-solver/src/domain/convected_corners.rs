@@ -4,7 +4,7 @@
 use mpm_basis::{Corners, MAX_CORNERS};
 use nalgebra::SVector;
 
-use super::{DomainContext, DomainError, DomainUpdater};
+use super::{DisplacementField, DomainContext, DomainError, DomainUpdater};
 
 /// CPDI2: every corner of the domain moves with the grid displacement
 /// increment, $x^c_i = \tilde X^c_i + \sum_v S_{vp}(\tilde{\mathbf X}^c)
@@ -29,14 +29,11 @@ pub struct ConvectedCorners;
 impl<const D: usize> DomainUpdater<D, Corners<D>> for ConvectedCorners {
     const NAME: &'static str = "cpdi2";
 
-    fn update<U>(
+    fn update(
         &self,
         ctx: &DomainContext<'_, D, Corners<D>>,
-        displacement_at: U,
-    ) -> Result<Corners<D>, DomainError>
-    where
-        U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
-    {
+        displacement_at: impl DisplacementField<D>,
+    ) -> Result<Corners<D>, DomainError> {
         let mut moved = [SVector::<f64, D>::zeros(); MAX_CORNERS];
         for (m, x) in moved.iter_mut().zip(ctx.previous.as_slice()) {
             *m = x + displacement_at(x)?;

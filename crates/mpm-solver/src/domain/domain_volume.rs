@@ -2,7 +2,7 @@
 
 use nalgebra::SVector;
 
-use super::{DomainContext, DomainError, DomainUpdater};
+use super::{DisplacementField, DomainError, DomainUpdater, GimpContext};
 
 /// A GIMP rule `U` whose points integrate with the volume of their domain,
 /// $V_p = \prod_i 2 l^p_i$ (per unit thickness in plane strain), instead
@@ -27,14 +27,11 @@ impl<const D: usize, U: DomainUpdater<D, SVector<f64, D>>> DomainUpdater<D, SVec
     const NAME: &'static str = U::NAME;
 
     #[inline]
-    fn update<V>(
+    fn update(
         &self,
-        ctx: &DomainContext<'_, D, SVector<f64, D>>,
-        displacement_at: V,
-    ) -> Result<SVector<f64, D>, DomainError>
-    where
-        V: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
-    {
+        ctx: &GimpContext<'_, D>,
+        displacement_at: impl DisplacementField<D>,
+    ) -> Result<SVector<f64, D>, DomainError> {
         self.0.update(ctx, displacement_at)
     }
 
@@ -47,7 +44,7 @@ impl<const D: usize, U: DomainUpdater<D, SVector<f64, D>>> DomainUpdater<D, SVec
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::domain::{DiagF, NoUpdate};
+    use crate::domain::{DiagF, DomainContext, NoUpdate};
     use nalgebra::{Matrix3, Vector2, Vector3};
 
     #[test]

@@ -5,7 +5,7 @@
 use mpm_basis::{Corners, MAX_CORNERS};
 use nalgebra::SVector;
 
-use super::{DomainContext, DomainError, DomainUpdater, checks};
+use super::{DisplacementField, DomainError, DomainUpdater, GimpContext, checks};
 
 /// The midpoint rule with the mid-points taken from the moved corners
 /// (Coombs et al. 2020 Fig. 5a, eqs. 35–37).
@@ -72,14 +72,11 @@ pub struct Midpoint;
 impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for CornerMidpoint {
     const NAME: &'static str = "corner_midpoint";
 
-    fn update<U>(
+    fn update(
         &self,
-        ctx: &DomainContext<'_, D, SVector<f64, D>>,
-        displacement_at: U,
-    ) -> Result<SVector<f64, D>, DomainError>
-    where
-        U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
-    {
+        ctx: &GimpContext<'_, D>,
+        displacement_at: impl DisplacementField<D>,
+    ) -> Result<SVector<f64, D>, DomainError> {
         midpoint_lengths(ctx, displacement_at, Source::Corners)
     }
 }
@@ -87,14 +84,11 @@ impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for CornerMidpoint {
 impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for Midpoint {
     const NAME: &'static str = "midpoint";
 
-    fn update<U>(
+    fn update(
         &self,
-        ctx: &DomainContext<'_, D, SVector<f64, D>>,
-        displacement_at: U,
-    ) -> Result<SVector<f64, D>, DomainError>
-    where
-        U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
-    {
+        ctx: &GimpContext<'_, D>,
+        displacement_at: impl DisplacementField<D>,
+    ) -> Result<SVector<f64, D>, DomainError> {
         midpoint_lengths(ctx, displacement_at, Source::Direct)
     }
 }
@@ -109,14 +103,11 @@ enum Source {
 }
 
 /// Eqs. (36)–(37) with the mid-points from `source`.
-fn midpoint_lengths<const D: usize, U>(
-    ctx: &DomainContext<'_, D, SVector<f64, D>>,
-    displacement_at: U,
+fn midpoint_lengths<const D: usize>(
+    ctx: &GimpContext<'_, D>,
+    displacement_at: impl DisplacementField<D>,
     source: Source,
-) -> Result<SVector<f64, D>, DomainError>
-where
-    U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
-{
+) -> Result<SVector<f64, D>, DomainError> {
     checks::half_lengths(ctx.initial, "initial")?;
     checks::half_lengths(ctx.previous, "previous")?;
     let j = checks::jacobian(ctx.f, "F")?;

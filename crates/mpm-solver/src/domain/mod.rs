@@ -122,10 +122,11 @@ impl<const D: usize, R: DeformationRule<D>> DomainUpdater<D, SVector<f64, D>> fo
     const NAME: &'static str = R::NAME;
 
     #[inline]
-    fn update<U>(&self, ctx: &GimpContext<'_, D>, _: U) -> Result<SVector<f64, D>, DomainError>
-    where
-        U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
-    {
+    fn update(
+        &self,
+        ctx: &GimpContext<'_, D>,
+        _: impl DisplacementField<D>,
+    ) -> Result<SVector<f64, D>, DomainError> {
         self.half_lengths(ctx)
     }
 }
@@ -148,6 +149,19 @@ pub struct DomainContext<'a, const D: usize, Dom> {
     pub position: &'a SVector<f64, D>,
 }
 
+/// The converged grid displacement increment as a function of a point of
+/// the configuration at the start of the step (eq. 35): what rules that
+/// convect corners or mid-points read. Every such closure is one.
+pub trait DisplacementField<const D: usize>:
+    Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>
+{
+}
+
+impl<const D: usize, F> DisplacementField<D> for F where
+    F: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>
+{
+}
+
 /// A rule that updates material point domains after a converged step.
 pub trait DomainUpdater<const D: usize, Dom>: Send + Sync {
     /// Name used in outputs and scene files.
@@ -157,13 +171,11 @@ pub trait DomainUpdater<const D: usize, Dom>: Send + Sync {
     /// grid displacement increment at a point $x$ of the configuration at
     /// the start of the step (eq. 35), for rules that convect corners or
     /// mid-points.
-    fn update<U>(
+    fn update(
         &self,
         ctx: &DomainContext<'_, D, Dom>,
-        displacement_at: U,
-    ) -> Result<Dom, DomainError>
-    where
-        U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>;
+        displacement_at: impl DisplacementField<D>,
+    ) -> Result<Dom, DomainError>;
 
     /// The converged volume of the point after the update, given the
     /// volume $\det(F)\,V^0_p$ of eqs. (5)/(22). Rules whose domain defines

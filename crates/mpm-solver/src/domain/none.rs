@@ -1,8 +1,6 @@
 //! No domain update (the "no update" column of Coombs et al. 2020 Table 2).
 
-use nalgebra::SVector;
-
-use super::{DomainContext, DomainError, DomainUpdater};
+use super::{DisplacementField, DomainContext, DomainError, DomainUpdater};
 
 /// Domains never change (the "no update" column of Table 2); also the only
 /// sensible choice for bases without a domain (`()`).
@@ -13,14 +11,11 @@ impl<const D: usize, Dom: Copy> DomainUpdater<D, Dom> for NoUpdate {
     const NAME: &'static str = "none";
 
     #[inline]
-    fn update<U>(
+    fn update(
         &self,
         ctx: &DomainContext<'_, D, Dom>,
-        _displacement_at: U,
-    ) -> Result<Dom, DomainError>
-    where
-        U: Fn(&SVector<f64, D>) -> Result<SVector<f64, D>, DomainError>,
-    {
+        _displacement_at: impl DisplacementField<D>,
+    ) -> Result<Dom, DomainError> {
         Ok(*ctx.previous)
     }
 }

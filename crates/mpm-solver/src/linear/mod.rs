@@ -112,31 +112,3 @@ pub trait LinearSolver: Send + std::fmt::Debug {
     /// Number of stored entries of the analysed pattern.
     fn nnz(&self) -> usize;
 }
-
-impl<S: LinearSolver + ?Sized> LinearSolver for Box<S> {
-    fn analyse(
-        &mut self,
-        n: usize,
-        col_ptr: &[usize],
-        row_idx: &[usize],
-        symmetric: bool,
-    ) -> Result<(), LinearSolveError> {
-        (**self).analyse(n, col_ptr, row_idx, symmetric)
-    }
-
-    fn solve(
-        &mut self,
-        values: &[f64],
-        rhs: &mut [f64],
-    ) -> Result<Factorisation, LinearSolveError> {
-        (**self).solve(values, rhs)
-    }
-
-    fn last_factorisation(&self) -> Option<Factorisation> {
-        (**self).last_factorisation()
-    }
-
-    fn nnz(&self) -> usize {
-        (**self).nnz()
-    }
-}
