@@ -19,6 +19,26 @@
 //!   [`parse_msh`]); physical groups and boundaries as [`NamedSets`].
 //! - [`MeshError`]: the crate's one error type; every variant names the
 //!   point, index, element, axis or file line where it happened.
+//!
+//! The meshes are data, not plug points: the bases of `mpm-basis` name the
+//! mesh they live on as an associated type, and `mpm-solver`'s
+//! `NodalMesh`/`MovableMesh` traits are implemented for both mesh types.
+//!
+//! ```
+//! use mpm_mesh::{BoxMesh, RegularGrid};
+//! use nalgebra::{Vector2, Vector3};
+//! // A regular grid: the cell of a point, and an error for one outside.
+//! let grid = RegularGrid::new(Vector2::zeros(), Vector2::new(0.5, 0.5), [4, 2])?;
+//! assert_eq!(grid.cell_containing(&Vector2::new(1.2, 0.7))?, [2, 1]);
+//! assert!(grid.cell_containing(&Vector2::new(3.0, 0.2)).is_err());
+//! // A tetrahedral box mesh located by walking from a hint (Wang et al.
+//! // 2021 Algorithm 1) finds the same element as brute force.
+//! let tets = BoxMesh::new(Vector3::zeros(), Vector3::repeat(1.0), [4, 4, 4]).simplex_mesh()?;
+//! let x = Vector3::new(0.313, 0.771, 0.529);
+//! let walked = tets.locate(&x, Some(0))?;
+//! assert_eq!(walked.element, tets.locate_brute_force(&x)?.element);
+//! # Ok::<(), mpm_mesh::MeshError>(())
+//! ```
 
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
