@@ -89,6 +89,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 .or(held.then_some(0.0))
         });
         sys.active_of_mesh = active_of_mesh;
+        sys.build_slot_offsets();
         let n_dofs = D * sys.n_active();
         let it = &mut self.it;
         it.du.clear();

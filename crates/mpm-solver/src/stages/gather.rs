@@ -11,7 +11,7 @@ use nalgebra::{Matrix3, SVector};
 use rayon::prelude::*;
 
 use crate::points::MaterialPoints;
-use crate::stages::system::{NONE, StepSystem};
+use crate::stages::system::{NONE, NOT_A_NEIGHBOUR, PARTIAL, StepSystem};
 
 /// Lumped nodal mass $m_v = \sum_p S_{vp} m_p$ per active node (MPoint
 /// eq. 22; the explicit solver's), into `out` (resized).
@@ -93,7 +93,8 @@ pub fn internal_force<const D: usize>(
 /// dofs, $K_{(vi)(wk)} = \sum_p \nabla_j S_{vp}\,T_{ijkl}\,\nabla_l S_{wp}$
 /// with each point's volume-weighted tangent `tangent_w`; one block column
 /// (active node $w$) per task, each entry summed over points in ascending
-/// order.
+/// order. Where each coupling goes comes from [`StepSystem::slot_offset`]
+/// (built once per step) when it exists.
 pub fn stiffness<const D: usize>(
     sys: &StepSystem<D>,
     grads: &[SVector<f64, D>],
@@ -104,6 +105,8 @@ pub fn stiffness<const D: usize>(
         vals.iter_mut().for_each(|x| *x = 0.0);
         let nbs = &sys.nb[sys.nb_ptr[w]..sys.nb_ptr[w + 1]];
         let map = &sys.block_map[sys.nb_ptr[w] * D * D..sys.nb_ptr[w + 1] * D * D];
+        // Column length of a block whose D columns are all present.
+        let column = vals.len() / D;
         for &(p, b) in &sys.adj[sys.adj_ptr[w]..sys.adj_ptr[w + 1]] {
             let p = p as usize;
             let t = &tangent_w[p];
@@ -121,29 +124,73 @@ pub fn stiffness<const D: usize>(
                     }
                 }
             }
+            let start = p * sys.stride;
+            let m = sys.counts[p] as usize;
+            let row = sys
+                .slot_offset_ptr
+                .get(p)
+                .map(|&ptr| &sys.slot_offset[ptr + b as usize * m..ptr + (b as usize + 1) * m]);
             for s in sys.slots(p) {
-                let v = sys.nodes[s];
-                let pos = match nbs.binary_search(&v) {
-                    Ok(pos) => pos,
-                    Err(_) => continue,
-                };
                 let gv = &grads[s];
-                for i in 0..D {
+                let entry = match row {
+                    Some(row) => row[s - start],
+                    None => match nbs.binary_search(&sys.nodes[s]) {
+                        Ok(pos) if pos < PARTIAL as usize => PARTIAL | pos as u16,
+                        Ok(pos) => {
+                            // Too wide for the table's flag: place each
+                            // entry through the block map.
+                            scatter_wide(&map[pos * D * D..(pos + 1) * D * D], gv, &q, vals);
+                            continue;
+                        }
+                        Err(_) => NOT_A_NEIGHBOUR,
+                    },
+                };
+                if entry == NOT_A_NEIGHBOUR {
+                    continue;
+                }
+                if entry & PARTIAL == 0 {
+                    // Both nodes free: rows i and columns k are contiguous.
+                    let base = entry as usize;
                     for k in 0..D {
-                        let off = map[(pos * D + i) * D + k];
-                        if off != NONE {
+                        for i in 0..D {
                             let mut acc = 0.0;
                             for j in 0..D {
                                 acc += gv[j] * q[i][j][k];
                             }
-                            vals[off as usize] += acc;
+                            vals[base + k * column + i] += acc;
                         }
                     }
+                    continue;
                 }
+                let pos = (entry & !PARTIAL) as usize;
+                scatter_wide(&map[pos * D * D..(pos + 1) * D * D], gv, &q, vals);
             }
         }
     };
     split_blocks(0, sys.n_active(), values, 0, &sys.block_ptr, &block);
+}
+
+/// Adds the coupling `gv · q` of one row node through its block-map rows
+/// `map` (entries [`NONE`] skipped).
+#[inline]
+fn scatter_wide<const D: usize>(
+    map: &[u32],
+    gv: &SVector<f64, D>,
+    q: &[[[f64; D]; D]; D],
+    vals: &mut [f64],
+) {
+    for i in 0..D {
+        for k in 0..D {
+            let off = map[i * D + k];
+            if off != NONE {
+                let mut acc = 0.0;
+                for j in 0..D {
+                    acc += gv[j] * q[i][j][k];
+                }
+                vals[off as usize] += acc;
+            }
+        }
+    }
 }
 
 /// Runs `f(w, values_of_block_w)` for the block columns `lo..hi` in

@@ -54,7 +54,34 @@ pub struct StepSystem<const D: usize> {
     /// block's value slice of row dof `(nb[pos], i)`, column dof `(w, k)`,
     /// or [`NONE`] if either is prescribed.
     pub block_map: Vec<u32>,
+    /// Per point `p` with `m` used slots, the `m × m` entries
+    /// `slot_offset[slot_offset_ptr[p] + b * m + a]` that place the
+    /// coupling of the node of slot `a` (row) with the node of slot `b`
+    /// (block column) in the stiffness values, so that the scatter does not
+    /// search the neighbour lists in every iteration: for two nodes whose
+    /// dofs are all free, the offset of row `(v_a, 0)` in column `(w_b, 0)`
+    /// of the block (row `(v_a, i)` of column `(w_b, k)` is `k` column
+    /// lengths and `i` rows further); otherwise [`PARTIAL`] plus the
+    /// position of `v_a` in the neighbour list of `w_b` (the block map then
+    /// places each entry). Empty when the table would exceed
+    /// [`MAX_SLOT_ENTRIES`] (very wide stencils in 3D): the scatter then
+    /// searches.
+    pub slot_offset: Vec<u16>,
+    /// See `slot_offset` (`n_points + 1` entries when the table is built).
+    pub slot_offset_ptr: Vec<usize>,
 }
+
+/// Largest number of entries of [`StepSystem::slot_offset`] (32 MiB);
+/// beyond it the stiffness scatter searches the neighbour lists.
+pub const MAX_SLOT_ENTRIES: usize = 16 << 20;
+
+/// Flag of a [`StepSystem::slot_offset`] entry that holds a neighbour-list
+/// position (a node pair with a prescribed dof) rather than an offset.
+pub const PARTIAL: u16 = 1 << 15;
+
+/// A [`StepSystem::slot_offset`] entry for a node not in the list (never
+/// written for a consistent system).
+pub const NOT_A_NEIGHBOUR: u16 = u16::MAX;
 
 impl<const D: usize> StepSystem<D> {
     /// Number of active nodes.
@@ -143,6 +170,58 @@ impl<const D: usize> StepSystem<D> {
             row.sort_unstable();
             self.nb.extend_from_slice(&row);
             self.nb_ptr.push(self.nb.len());
+        }
+    }
+
+    /// Whether every dof of active node `v` is free (after
+    /// [`Self::build_pattern`]).
+    #[inline]
+    pub fn all_free(&self, v: usize) -> bool {
+        self.free_of_dof[D * v..D * v + D]
+            .iter()
+            .all(|&f| f != NONE)
+    }
+
+    /// The placement table [`Self::slot_offset`], once per step after
+    /// [`Self::build_pattern`].
+    pub fn build_slot_offsets(&mut self) {
+        self.slot_offset.clear();
+        self.slot_offset_ptr.clear();
+        let total: usize = self.counts.iter().map(|&m| (m as usize).pow(2)).sum();
+        let largest_block = self.block_ptr.windows(2).map(|w| w[1] - w[0]).max();
+        // Offsets within a block and list positions must fit beside the flag.
+        let widest = (0..self.n_active())
+            .map(|w| self.nb_ptr[w + 1] - self.nb_ptr[w])
+            .max()
+            .unwrap_or(0);
+        if total > MAX_SLOT_ENTRIES
+            || largest_block.unwrap_or(0) >= PARTIAL as usize
+            || widest >= PARTIAL as usize
+        {
+            return;
+        }
+        self.slot_offset.reserve(total);
+        self.slot_offset_ptr.push(0);
+        for p in 0..self.counts.len() {
+            for b in self.slots(p) {
+                let w = self.nodes[b] as usize;
+                let nbs = &self.nb[self.nb_ptr[w]..self.nb_ptr[w + 1]];
+                let w_free = self.all_free(w);
+                for a in self.slots(p) {
+                    let v = self.nodes[a];
+                    // Every node of the point's stencil shares the point
+                    // with `w`, so it is in `w`'s neighbour list.
+                    let entry = match nbs.binary_search(&v) {
+                        Ok(pos) if w_free && self.all_free(v as usize) => {
+                            self.block_map[self.nb_ptr[w] * D * D + pos * D * D] as u16
+                        }
+                        Ok(pos) => PARTIAL | pos as u16,
+                        Err(_) => NOT_A_NEIGHBOUR,
+                    };
+                    self.slot_offset.push(entry);
+                }
+            }
+            self.slot_offset_ptr.push(self.slot_offset.len());
         }
     }
 
