@@ -207,7 +207,14 @@ proptest! {
         prop_assert_eq!(r.state.history, loaded.state.history);
         let expected_norm = (1.0 - u).abs() * law.current_yield_stress(&loaded.state.history);
         let s2 = r.tau - r.tau.trace() / 3.0 * Matrix3::identity();
-        prop_assert!((s2.norm() - expected_norm).abs() <= 1e-8 * law.yield_stress());
+        // The deviator is taken from τ, whose volumetric part is of order
+        // K ln J: for ν = 0.4999 (K ≈ 1.7e7 here) and stretches to 3 its
+        // rounding, a few ε‖τ‖ after two updates, exceeds 1e-8 ρ_y. The
+        // same floor as the yield-surface test above (8 ε‖τ‖); CI drew
+        // ν = 0.4999, u = 1.87 with an error of 3.7 ε‖τ‖ (committed in
+        // behaviour.proptest-regressions).
+        let rounding = 8.0 * f64::EPSILON * r.tau.norm();
+        prop_assert!((s2.norm() - expected_norm).abs() <= 1e-8 * law.yield_stress() + rounding);
     }
 
     /// Arbitrary (also inverted or singular) increments give either a typed
