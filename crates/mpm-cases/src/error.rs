@@ -21,10 +21,10 @@ pub enum CasesError {
         source: std::io::Error,
     },
     /// The background mesh could not be updated for output.
-    #[error("background mesh: {reason}")]
+    #[error("background mesh: {source}")]
     Mesh {
         /// What went wrong.
-        reason: String,
+        source: mpm_solver::MeshMotionError,
     },
     /// A checkpoint file that cannot be resumed from.
     #[error("{}: not a usable checkpoint: {reason}", path.display())]

@@ -164,7 +164,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
         if let Some(nodes) = &snap.mesh_nodes {
             self.grid
                 .set_nodes(nodes)
-                .map_err(|reason| CasesError::Mesh { reason })?;
+                .map_err(|source| CasesError::Mesh { source })?;
         }
         let name = format!("points_{step:04}.vtu");
         let path = self.dir.join(&name);

@@ -632,14 +632,7 @@ impl<const D: usize> Specialised<D> {
                 d2 += fe * fe;
             }
         }
-        let (r, d) = (f64::sqrt(r2), f64::sqrt(d2));
-        if r == 0.0 {
-            0.0
-        } else if d == 0.0 {
-            f64::INFINITY
-        } else {
-            r / d
-        }
+        mpm_solver::stages::convergence::ratio(r2.sqrt(), d2.sqrt())
     }
 
     /// The internal force at the free dofs.

@@ -3,7 +3,7 @@
 //! every step (moving meshes included).
 
 use mpm_mesh::{RegularGrid, SimplexMesh};
-use mpm_solver::MovableMesh;
+use mpm_solver::{MeshMotionError, MovableMesh};
 use nalgebra::SVector;
 
 use super::vtk::CellType;
@@ -25,7 +25,7 @@ pub trait CellMesh<const D: usize>: Clone + Send + Sync {
     ///
     /// # Errors
     /// A message when the mesh cannot take that shape.
-    fn set_nodes(&mut self, nodes: &[[f64; 3]]) -> Result<(), String>;
+    fn set_nodes(&mut self, nodes: &[[f64; 3]]) -> Result<(), MeshMotionError>;
 }
 
 fn unpad<const D: usize>(x: &[f64; 3]) -> SVector<f64, D> {
@@ -59,11 +59,12 @@ fn grid_cells<const D: usize>(grid: &RegularGrid<D>, points: &[[f64; 3]]) -> Vec
         .collect()
 }
 
-fn set_grid_nodes<const D: usize>(
-    grid: &mut RegularGrid<D>,
+/// Moves a mesh's nodes to the padded positions `nodes` (one per node).
+fn move_nodes<const D: usize, M: MovableMesh<D>>(
+    mesh: &mut M,
     nodes: &[[f64; 3]],
-) -> Result<(), String> {
-    MovableMesh::move_nodes(grid, nodes.iter().map(unpad).collect()).map_err(|e| e.to_string())
+) -> Result<(), MeshMotionError> {
+    mesh.move_nodes(nodes.iter().map(unpad).collect())
 }
 
 /// The node ids of cell `cell` in VTK order: counter-clockwise in 2D;
@@ -107,8 +108,8 @@ impl<const D: usize> CellMesh<D> for RegularGrid<D> {
     fn cells_holding(&self, points: &[[f64; 3]]) -> Vec<usize> {
         connectivity(grid_cells(self, points), |c| grid_cell_nodes(self, c))
     }
-    fn set_nodes(&mut self, nodes: &[[f64; 3]]) -> Result<(), String> {
-        set_grid_nodes(self, nodes)
+    fn set_nodes(&mut self, nodes: &[[f64; 3]]) -> Result<(), MeshMotionError> {
+        move_nodes(self, nodes)
     }
 }
 
@@ -125,14 +126,6 @@ fn simplex_cells<const D: usize>(mesh: &SimplexMesh<D>, points: &[[f64; 3]]) -> 
     connectivity(cells, |e| mesh.element_nodes(e).to_vec())
 }
 
-fn set_simplex_nodes<const D: usize>(
-    mesh: &mut SimplexMesh<D>,
-    nodes: &[[f64; 3]],
-) -> Result<(), String> {
-    mesh.move_nodes(nodes.iter().map(unpad).collect())
-        .map_err(|e| e.to_string())
-}
-
 impl<const D: usize> CellMesh<D> for SimplexMesh<D> {
     /// Triangles in 2D, tetrahedra in 3D (other dimensions do not compile).
     const CELL: CellType = match D {
@@ -146,8 +139,8 @@ impl<const D: usize> CellMesh<D> for SimplexMesh<D> {
     fn cells_holding(&self, points: &[[f64; 3]]) -> Vec<usize> {
         simplex_cells(self, points)
     }
-    fn set_nodes(&mut self, nodes: &[[f64; 3]]) -> Result<(), String> {
-        set_simplex_nodes(self, nodes)
+    fn set_nodes(&mut self, nodes: &[[f64; 3]]) -> Result<(), MeshMotionError> {
+        move_nodes(self, nodes)
     }
 }
 
