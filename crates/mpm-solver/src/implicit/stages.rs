@@ -274,9 +274,19 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             .try_for_each(|(p, (t, r))| {
                 if let Some(r) = r {
                     let volume = P::Formulation::volume(r, points.volume[p]);
-                    *t = <P::Formulation as Formulation>::Tangent::tangent(law, r)
-                        .map_err(|source| StepFailure::Constitutive { point: p, source })?
-                        * volume;
+                    // Read in place and scaled into `t`: moving the tensor
+                    // out of its `Result` and multiplying by value are two
+                    // 648-byte copies the compiler does not elide.
+                    let tangent = <P::Formulation as Formulation>::Tangent::tangent(law, r);
+                    match &tangent {
+                        Ok(a) => t.zip_apply(a, |x, y| *x = y * volume),
+                        Err(source) => {
+                            return Err(StepFailure::Constitutive {
+                                point: p,
+                                source: *source,
+                            });
+                        }
+                    }
                 }
                 Ok(())
             })

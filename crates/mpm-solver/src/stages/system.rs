@@ -58,30 +58,34 @@ pub struct StepSystem<const D: usize> {
     /// `slot_offset[slot_offset_ptr[p] + b * m + a]` that place the
     /// coupling of the node of slot `a` (row) with the node of slot `b`
     /// (block column) in the stiffness values, so that the scatter does not
-    /// search the neighbour lists in every iteration: for two nodes whose
-    /// dofs are all free, the offset of row `(v_a, 0)` in column `(w_b, 0)`
-    /// of the block (row `(v_a, i)` of column `(w_b, k)` is `k` column
-    /// lengths and `i` rows further); otherwise [`PARTIAL`] plus the
-    /// position of `v_a` in the neighbour list of `w_b` (the block map then
-    /// places each entry). Empty when the table would exceed
-    /// [`MAX_SLOT_ENTRIES`] (very wide stencils in 3D): the scatter then
-    /// searches.
-    pub slot_offset: Vec<u16>,
+    /// search the neighbour lists in every iteration: the position `pos` of
+    /// `v_a` in the neighbour list of `w_b`, plus [`PARTIAL`] when either
+    /// node has a prescribed dof. For two free nodes, row `(v_a, i)` of
+    /// column `(w_b, k)` is at the block map's entry `(pos, 0, 0)` plus `i`
+    /// rows and `k` column lengths; otherwise the block map places each
+    /// entry. One byte per pair keeps the table small (64 bytes per point
+    /// for linear hexahedra), which matters more than the indirection: the
+    /// stiffness pass reads every point once from each of its nodes, a grid
+    /// layer apart. Empty when a neighbour list has more than 126 entries
+    /// (wider than the 5³ stencils of GIMP or quadratic B-splines on
+    /// hexahedra) or the table would exceed
+    /// [`MAX_SLOT_ENTRIES`]: the scatter then searches.
+    pub slot_offset: Vec<u8>,
     /// See `slot_offset` (`n_points + 1` entries when the table is built).
     pub slot_offset_ptr: Vec<usize>,
 }
 
-/// Largest number of entries of [`StepSystem::slot_offset`] (32 MiB);
+/// Largest number of entries of [`StepSystem::slot_offset`] (16 MiB);
 /// beyond it the stiffness scatter searches the neighbour lists.
 pub const MAX_SLOT_ENTRIES: usize = 16 << 20;
 
-/// Flag of a [`StepSystem::slot_offset`] entry that holds a neighbour-list
-/// position (a node pair with a prescribed dof) rather than an offset.
-pub const PARTIAL: u16 = 1 << 15;
+/// Flag of a [`StepSystem::slot_offset`] entry for a node pair with a
+/// prescribed dof (placed entry by entry through the block map).
+pub const PARTIAL: u8 = 1 << 7;
 
 /// A [`StepSystem::slot_offset`] entry for a node not in the list (never
 /// written for a consistent system).
-pub const NOT_A_NEIGHBOUR: u16 = u16::MAX;
+pub const NOT_A_NEIGHBOUR: u8 = u8::MAX;
 
 impl<const D: usize> StepSystem<D> {
     /// Number of active nodes.
@@ -188,16 +192,13 @@ impl<const D: usize> StepSystem<D> {
         self.slot_offset.clear();
         self.slot_offset_ptr.clear();
         let total: usize = self.counts.iter().map(|&m| (m as usize).pow(2)).sum();
-        let largest_block = self.block_ptr.windows(2).map(|w| w[1] - w[0]).max();
-        // Offsets within a block and list positions must fit beside the flag.
+        // List positions must fit below the flag, and a flagged position
+        // must differ from `NOT_A_NEIGHBOUR`.
         let widest = (0..self.n_active())
             .map(|w| self.nb_ptr[w + 1] - self.nb_ptr[w])
             .max()
             .unwrap_or(0);
-        if total > MAX_SLOT_ENTRIES
-            || largest_block.unwrap_or(0) >= PARTIAL as usize
-            || widest >= PARTIAL as usize
-        {
+        if total > MAX_SLOT_ENTRIES || widest >= (NOT_A_NEIGHBOUR & !PARTIAL) as usize {
             return;
         }
         self.slot_offset.reserve(total);
@@ -212,10 +213,8 @@ impl<const D: usize> StepSystem<D> {
                     // Every node of the point's stencil shares the point
                     // with `w`, so it is in `w`'s neighbour list.
                     let entry = match nbs.binary_search(&v) {
-                        Ok(pos) if w_free && self.all_free(v as usize) => {
-                            self.block_map[self.nb_ptr[w] * D * D + pos * D * D] as u16
-                        }
-                        Ok(pos) => PARTIAL | pos as u16,
+                        Ok(pos) if w_free && self.all_free(v as usize) => pos as u8,
+                        Ok(pos) => PARTIAL | pos as u8,
                         Err(_) => NOT_A_NEIGHBOUR,
                     };
                     self.slot_offset.push(entry);
