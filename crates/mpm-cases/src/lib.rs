@@ -31,6 +31,7 @@ pub mod material;
 pub mod output;
 pub mod params;
 pub mod run;
+pub mod scene;
 pub mod scene_file;
 pub mod variant;
 pub mod writer;

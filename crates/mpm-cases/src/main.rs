@@ -41,7 +41,9 @@ enum Command {
     List,
     /// Run a scene file or a named case.
     Run {
-        /// Scene file (TOML); its `case` key names the case.
+        /// Scene file (TOML): a whole problem (`[mesh]`, `[[material]]`,
+        /// `[[body]]`, ...; see docs/src/guide/scenes.md), or the
+        /// parameters of the built-in case its `case` key names.
         scene: Option<PathBuf>,
         /// Case to run without a scene file.
         #[arg(long)]
@@ -163,9 +165,14 @@ fn run_cli(cli: Cli) -> Result<()> {
             } else {
                 None
             };
-            let name = case.or(scene_case).ok_or_else(|| {
-                anyhow!("no case: give --case NAME or a scene file with `case = \"...\"`")
-            })?;
+            let is_scene = scene.is_some() && case.is_none() && scene_case.is_none();
+            let name = if is_scene {
+                "scene".to_owned()
+            } else {
+                case.or(scene_case).ok_or_else(|| {
+                    anyhow!("no case: give --case NAME or a scene file with `case = \"...\"`")
+                })?
+            };
             let run = Run {
                 case: name.clone(),
                 out,
@@ -179,6 +186,7 @@ fn run_cli(cli: Cli) -> Result<()> {
                     .unwrap_or_default(),
             };
             let result = match name.as_str() {
+                _ if is_scene => scene_run(&text, &origin, &set, &run),
                 "column" => column_run(&parse_scene(&text, &origin, &set)?, &run),
                 "shear" => shear_run(&parse_scene(&text, &origin, &set)?, &run),
                 "cantilever" => cantilever_run(&parse_scene(&text, &origin, &set)?, &run),
@@ -536,6 +544,132 @@ fn stretch_run(mut p: stretch::StretchParams, run: &Run) -> Result<()> {
         Some(r.error),
         results,
         &p,
+    );
+    obs.finish(s)
+}
+
+/// A scene file describing a whole problem (no `case` key).
+fn scene_run(text: &str, origin: &str, set: &[String], run: &Run) -> Result<()> {
+    let (scene, source) = mpm_cases::scene::parse(text, origin, set)?;
+    match mpm_cases::scene::dimension(&scene, &source)? {
+        2 => scene_run_in::<2>(&scene, &source, run),
+        _ => scene_run_in::<3>(&scene, &source, run),
+    }
+}
+
+fn scene_run_in<const D: usize>(
+    scene: &mpm_cases::scene::Scene,
+    source: &mpm_cases::scene_file::SceneSource,
+    run: &Run,
+) -> Result<()> {
+    use mpm_cases::output::CsvValue;
+    use mpm_cases::scene::Problem;
+    use mpm_cases::writer::VtuOptions;
+
+    let problem = Problem::<D>::build(scene, source, scene.solver.basis.padding())?;
+    let (mut obs, control) = run.start(scene, problem.grid.clone())?;
+    obs.writer.set_vtu_options(VtuOptions {
+        every: problem.every,
+        fields: problem.fields.clone(),
+        constants: vec![
+            (
+                "body".into(),
+                problem.body_of_point.iter().map(|&b| f64::from(b)).collect(),
+            ),
+            (
+                "material".into(),
+                problem
+                    .material_of_point
+                    .iter()
+                    .map(|&m| f64::from(m))
+                    .collect(),
+            ),
+        ],
+    });
+    let axes = ["x", "y", "z"];
+    let reaction_header: Vec<String> = std::iter::once("load_factor".to_owned())
+        .chain(axes.iter().take(D).map(|a| format!("reaction_{a}")))
+        .collect();
+    let probe_header: Vec<String> = std::iter::once("load_factor".to_owned())
+        .chain(axes.iter().take(D).map(|a| format!("u{a}")))
+        .collect();
+    let mut last_reactions = Map::new();
+    let mut last_probes = Map::new();
+    let r = mpm_cases::scene::run(&problem, &control, |s, rep, snap| {
+        let io = |e: mpm_cases::CasesError| SolverError::Observer(ObserverError::new(e));
+        for (name, nodes) in &problem.reactions {
+            let total = rep
+                .node_reactions
+                .iter()
+                .filter(|(v, _)| nodes.binary_search(v).is_ok())
+                .fold(nalgebra::SVector::<f64, D>::zeros(), |t, (_, r)| t + r);
+            let mut row = vec![CsvValue::from(rep.lambda1)];
+            row.extend(total.iter().map(|x| CsvValue::from(*x)));
+            let header: Vec<&str> = reaction_header.iter().map(String::as_str).collect();
+            obs.writer
+                .case_row(&format!("reaction_{name}.csv"), &header, &row)
+                .map_err(io)?;
+            last_reactions.insert(name.clone(), json!(total.as_slice()));
+        }
+        for (name, p) in &problem.probes {
+            let u = &snap.displacement[*p][..D];
+            let mut row = vec![CsvValue::from(rep.lambda1)];
+            row.extend(u.iter().map(|x| CsvValue::from(*x)));
+            let header: Vec<&str> = probe_header.iter().map(String::as_str).collect();
+            obs.writer
+                .case_row(&format!("probe_{name}.csv"), &header, &row)
+                .map_err(io)?;
+            last_probes.insert(name.clone(), json!(u));
+        }
+        obs.step(s, rep, snap)
+    })?;
+    let mut results = Map::new();
+    results.insert("reactions".into(), Value::Object(last_reactions));
+    results.insert("probes".into(), Value::Object(last_probes));
+    results.insert(
+        "bodies".into(),
+        json!(problem
+            .bodies
+            .iter()
+            .map(|b| json!({"name": b.name, "material_points": b.points.len()}))
+            .collect::<Vec<_>>()),
+    );
+    if problem.png {
+        let last = &r.last;
+        let plastic = last.plastic_strain.iter().any(|&e| e > 0.0);
+        let (name, value): (&str, Vec<f64>) = if plastic {
+            ("equivalent_plastic_strain", last.plastic_strain.clone())
+        } else {
+            (
+                "displacement_magnitude",
+                last.displacement
+                    .iter()
+                    .map(|u| (u[0] * u[0] + u[1] * u[1]).sqrt())
+                    .collect(),
+            )
+        };
+        let half: Vec<f64> = problem
+            .half_lengths
+            .iter()
+            .zip(&last.volume)
+            .zip(&problem.volume)
+            .map(|((l, v), v0)| l[0] * (v / v0).sqrt())
+            .collect();
+        let path = obs.writer.dir().join("final.png");
+        let (lo, hi) = mpm_cases::scene::png::write_points_png(&path, &last.position, &half, &value)?;
+        results.insert(
+            "png".into(),
+            json!({"file": "final.png", "colour": name, "blue": lo, "red": hi}),
+        );
+    }
+    let s = summary(
+        "scene",
+        problem.variant,
+        problem.len(),
+        &r,
+        None,
+        results,
+        scene,
     );
     obs.finish(s)
 }

@@ -4,7 +4,7 @@
 //! A new law is one file in `mpm-constitutive` (an implementation of
 //! `LogStrainLaw`) and one line in the [`register_laws!`] call below.
 
-use mpm_constitutive::{HenckyElastic, LogStrainLaw, VonMises};
+use mpm_constitutive::{HenckyElastic, LogStrainLaw, MaterialSet, Tagged, VonMises, VonMisesHistory};
 use mpm_solver::{Flat, SolverError};
 
 use crate::run::HistoryOutput;
@@ -22,8 +22,44 @@ pub struct MaterialParams {
     pub hardening: f64,
 }
 
+/// The initial history of a point of material `material` (an index into
+/// the scene's materials): the law's default history, tagged with the
+/// material when the law is a [`MaterialSet`].
+pub trait MaterialTag {
+    /// The history a point of `material` starts with.
+    fn for_material(material: u32) -> Self;
+    /// The material a history belongs to (0 for laws of one material).
+    fn material(&self) -> u32;
+}
+
+impl MaterialTag for () {
+    fn for_material(_: u32) -> Self {}
+    fn material(&self) -> u32 {
+        0
+    }
+}
+
+impl MaterialTag for VonMisesHistory {
+    fn for_material(_: u32) -> Self {
+        Self::default()
+    }
+    fn material(&self) -> u32 {
+        0
+    }
+}
+
+impl<H: Default> MaterialTag for Tagged<H> {
+    fn for_material(material: u32) -> Self {
+        Tagged::new(material, H::default())
+    }
+    fn material(&self) -> u32 {
+        self.material
+    }
+}
+
 /// A computation generic over the law; [`dispatch_law`] calls it with the
-/// law a [`MaterialModel`] names.
+/// law a [`MaterialModel`] names, [`dispatch_law_set`] with a
+/// [`MaterialSet`] of them.
 pub trait LawVisitor {
     /// What the computation returns.
     type Output;
@@ -32,7 +68,7 @@ pub trait LawVisitor {
     fn visit<L>(self, law: L) -> Self::Output
     where
         L: LogStrainLaw,
-        L::History: HistoryOutput + Flat;
+        L::History: HistoryOutput + Flat + MaterialTag;
 }
 
 /// One line per law: the variant, its name in scene files, and how the law
@@ -60,6 +96,29 @@ macro_rules! register_laws {
                 $(MaterialModel::$variant => {
                     let $p = params;
                     Ok(visitor.visit($make?))
+                })+
+            }
+        }
+
+        /// Builds one law of `model` per entry of `params` and calls
+        /// `visitor` with their [`MaterialSet`] (material `k` is
+        /// `params[k]`).
+        ///
+        /// # Errors
+        /// As [`dispatch_law`], and [`SolverError::Material`] for an empty
+        /// `params`.
+        pub fn dispatch_law_set<V: LawVisitor>(
+            model: MaterialModel,
+            params: &[MaterialParams],
+            visitor: V,
+        ) -> Result<V::Output, SolverError> {
+            match model {
+                $(MaterialModel::$variant => {
+                    let laws = params
+                        .iter()
+                        .map(|$p| -> Result<_, SolverError> { Ok($make?) })
+                        .collect::<Result<Vec<_>, _>>()?;
+                    Ok(visitor.visit(MaterialSet::new(laws)?))
                 })+
             }
         }

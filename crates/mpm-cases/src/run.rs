@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use mpm_constitutive::{LogStrainLaw, VonMisesHistory};
+use mpm_constitutive::{LogStrainLaw, Tagged, VonMisesHistory};
 use mpm_solver::{
     BodyForcePath, Constraints, DomainUpdater, Flat, Formulation, ImplicitSolver, LoadStepping,
     MaterialPoints, MovableMesh, NewtonOptions, NoLocking, NodalMesh, Parts, RunState, RunSummary,
@@ -22,6 +22,12 @@ pub trait HistoryOutput {
 impl HistoryOutput for () {
     fn equivalent_plastic_strain(&self) -> f64 {
         0.0
+    }
+}
+
+impl<H: HistoryOutput> HistoryOutput for Tagged<H> {
+    fn equivalent_plastic_strain(&self) -> f64 {
+        self.inner.equivalent_plastic_strain()
     }
 }
 
@@ -217,6 +223,22 @@ pub struct Setup<'a, const D: usize, M, L, C> {
     pub newton: NewtonOptions,
 }
 
+/// Everything of an analysis but its material points: the mesh, the law,
+/// the Dirichlet conditions and the controls.
+#[derive(Debug, Clone)]
+pub struct Analysis<M, L, C> {
+    /// The background mesh.
+    pub grid: M,
+    /// The material.
+    pub law: L,
+    /// Dirichlet conditions.
+    pub constraints: C,
+    /// Load stepping.
+    pub stepping: LoadStepping,
+    /// Newton controls.
+    pub newton: NewtonOptions,
+}
+
 /// Runs `setup` with basis `B`, formulation `F` and updater `U`; `observer`
 /// sees each converged step's report and state (its time is excluded from
 /// `wall_time_s`). `control` asks for checkpoints or resumes from one.
@@ -225,7 +247,7 @@ pub fn simulate<const D: usize, B, F, U, L, C, O>(
     basis: B,
     updater: U,
     control: &RunControl,
-    mut observer: O,
+    observer: O,
 ) -> Result<RunOutput<D>, SolverError>
 where
     B: InitialDomain<D>,
@@ -256,6 +278,38 @@ where
     }
     points.point_force = setup.loads.point_forces.clone();
     points.body_force_path = setup.loads.body_force_path.clone();
+    let analysis = Analysis {
+        grid: setup.grid,
+        law: setup.law,
+        constraints: setup.constraints,
+        stepping: setup.stepping,
+        newton: setup.newton,
+    };
+    simulate_points::<D, B, F, U, L, C, O>(points, analysis, basis, updater, control, observer)
+}
+
+/// [`simulate`] from material points the caller has set up (per-point
+/// masses, initial histories such as material tags, loads).
+pub fn simulate_points<const D: usize, B, F, U, L, C, O>(
+    mut points: MaterialPoints<D, L::History, B::Domain>,
+    analysis: Analysis<B::Mesh, L, C>,
+    basis: B,
+    updater: U,
+    control: &RunControl,
+    mut observer: O,
+) -> Result<RunOutput<D>, SolverError>
+where
+    B: InitialDomain<D>,
+    B::Mesh: MovableMesh<D>,
+    B::Domain: Flat + DomainBounds<D>,
+    F: Formulation,
+    U: DomainUpdater<D, B::Domain>,
+    L: LogStrainLaw,
+    L::History: HistoryOutput + Flat,
+    C: Constraints<D>,
+    O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
+{
+    let setup = analysis;
     let mut solver: ImplicitSolver<D, Parts<B, F, L, NoLocking, U, C>> = ImplicitSolver::new(
         basis,
         setup.grid,

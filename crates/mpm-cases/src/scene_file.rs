@@ -79,11 +79,26 @@ pub fn parse_scene<T: DeserializeOwned>(
     origin: &str,
     overrides: &[String],
 ) -> Result<T, CasesError> {
+    parse_scene_located(text, origin, overrides).map(|(scene, _)| scene)
+}
+
+/// [`parse_scene`], also returning the [`SceneSource`] that turns the
+/// spans of `toml::Spanned` fields of `T` into located errors (for checks
+/// after deserialisation: a name that refers to nothing, a body outside
+/// the mesh).
+///
+/// # Errors
+/// As [`parse_scene`].
+pub fn parse_scene_located<T: DeserializeOwned>(
+    text: &str,
+    origin: &str,
+    overrides: &[String],
+) -> Result<(T, SceneSource), CasesError> {
     let parsed: Vec<Override<'_>> = overrides
         .iter()
         .map(|o| Override::parse(o))
         .collect::<Result<_, _>>()?;
-    let locate = Locator::new(text, origin, &parsed);
+    let locate = SceneSource::new(text, origin, overrides);
 
     let mut root = DeTable::parse(text).map_err(|e| locate.error(e.span(), e.message()))?;
     if let Some(span) = first_non_finite_in_table(root.get_ref()) {
@@ -95,10 +110,11 @@ pub fn parse_scene<T: DeserializeOwned>(
     // An error carrying the root table's span (e.g. a missing top-level key)
     // says nothing about where: it is reported without a position.
     let root_span = root.span();
-    T::deserialize(toml::de::Deserializer::from(root)).map_err(|e| {
+    let scene = T::deserialize(toml::de::Deserializer::from(root)).map_err(|e| {
         let span = e.span().filter(|s| *s != root_span);
         locate.error(span, e.message())
-    })
+    })?;
+    Ok((scene, locate))
 }
 
 /// One `key=value` override, split and checked.
@@ -237,43 +253,53 @@ fn first_non_finite_in_table(table: &DeTable<'_>) -> Option<Range<usize>> {
     table.values().find_map(first_non_finite)
 }
 
-/// Maps byte spans to places: in the file, or in one of the overrides,
-/// which are given spans past the end of the file.
-struct Locator<'a> {
-    text: &'a str,
-    origin: &'a str,
-    overrides: &'a [Override<'a>],
+/// Where a scene came from: its text and origin and the overrides applied
+/// to it, which are given spans past the end of the text. Maps the byte
+/// spans of the parsed document (`toml::Spanned` fields) to places.
+#[derive(Debug, Clone, Default)]
+pub struct SceneSource {
+    text: String,
+    origin: String,
+    overrides: Vec<String>,
     /// Start of each override's virtual span.
     starts: Vec<usize>,
 }
 
-impl<'a> Locator<'a> {
-    fn new(text: &'a str, origin: &'a str, overrides: &'a [Override<'a>]) -> Self {
+impl SceneSource {
+    fn new(text: &str, origin: &str, overrides: &[String]) -> Self {
         let mut starts = Vec::with_capacity(overrides.len());
         let mut next = text.len() + 1;
         for o in overrides {
             starts.push(next);
-            next += o.text.len().max(1) + 1;
+            next += o.len().max(1) + 1;
         }
         Self {
-            text,
-            origin,
-            overrides,
+            text: text.to_owned(),
+            origin: origin.to_owned(),
+            overrides: overrides.to_vec(),
             starts,
         }
+    }
+
+    /// The origin (file name) errors start with.
+    pub fn origin(&self) -> &str {
+        &self.origin
     }
 
     /// The virtual span of override `k`.
     fn span_of(&self, k: usize) -> Range<usize> {
         let start = self.starts[k];
-        start..start + self.overrides[k].text.len().max(1)
+        start..start + self.overrides[k].len().max(1)
     }
 
-    fn error(&self, span: Option<Range<usize>>, message: &str) -> CasesError {
+    /// An error at `span` of the parsed document: `origin:line:column:
+    /// message` in the file, or naming the override the span belongs to;
+    /// without a span, the origin only.
+    pub fn error(&self, span: Option<Range<usize>>, message: &str) -> CasesError {
         let message = message.trim_end().to_owned();
         let Some(span) = span else {
             return CasesError::SceneUnlocated {
-                origin: self.origin.to_owned(),
+                origin: self.origin.clone(),
                 message,
             };
         };
@@ -283,16 +309,24 @@ impl<'a> Locator<'a> {
                 .partition_point(|&s| s <= span.start)
                 .saturating_sub(1);
             if let Some(o) = self.overrides.get(k) {
-                return o.error(message);
+                return CasesError::Override {
+                    text: o.clone(),
+                    message,
+                };
             }
         }
-        let (line, column) = line_column(self.text, span.start);
+        let (line, column) = line_column(&self.text, span.start);
         CasesError::Scene {
-            origin: self.origin.to_owned(),
+            origin: self.origin.clone(),
             line,
             column,
             message,
         }
+    }
+
+    /// [`Self::error`] at the place of `value`.
+    pub fn at<T>(&self, value: &Spanned<T>, message: impl AsRef<str>) -> CasesError {
+        self.error(Some(value.span()), message.as_ref())
     }
 
     fn non_finite(&self, span: Range<usize>) -> CasesError {

@@ -68,6 +68,16 @@ macro_rules! register_bases {
             BasisKind { $($(#[$doc])* $variant => $text),+ }
         );
 
+        impl BasisKind {
+            /// Padding cells the basis needs around the body
+            /// (`BasisFunction::PADDING`).
+            pub fn padding(self) -> usize {
+                match self {
+                    $(BasisKind::$variant => <$ty as mpm_basis::BasisFunction<2>>::PADDING,)+
+                }
+            }
+        }
+
         /// Calls `visitor` with the basis named by `variant.basis`.
         fn dispatch_basis<const D: usize, V: VariantVisitor<D>>(
             variant: &Variant,

@@ -28,6 +28,64 @@ pub struct RunWriter<const D: usize, M> {
     steps: CsvTable,
     iterations: CsvTable,
     tables: BTreeMap<String, CsvTable>,
+    options: VtuOptions,
+}
+
+/// Fields of the material-point VTU files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Field {
+    /// Total displacement (`displacement`).
+    Displacement,
+    /// Cauchy stress (`cauchy_stress`).
+    Stress,
+    /// Deformation gradient (`deformation_gradient`).
+    DeformationGradient,
+    /// Volume (`volume`).
+    Volume,
+    /// Equivalent plastic strain (`equivalent_plastic_strain`).
+    PlasticStrain,
+    /// GIMP/CPDI2 domain bounds (`domain_lower`, `domain_upper`).
+    Domain,
+    /// The per-point constants of [`VtuOptions::constants`] (e.g. a scene's
+    /// body and material indices).
+    Body,
+}
+
+impl Field {
+    /// Every field.
+    pub const ALL: [Field; 7] = [
+        Field::Displacement,
+        Field::Stress,
+        Field::DeformationGradient,
+        Field::Volume,
+        Field::PlasticStrain,
+        Field::Domain,
+        Field::Body,
+    ];
+}
+
+/// What the VTU files of a run hold and how often they are written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VtuOptions {
+    /// Write the VTU files of every this many steps (and of the step that
+    /// reaches load factor 1).
+    pub every: usize,
+    /// The material-point fields written.
+    pub fields: Vec<Field>,
+    /// Per-point constants written with [`Field::Body`]: name and one
+    /// value per point.
+    pub constants: Vec<(String, Vec<f64>)>,
+}
+
+impl Default for VtuOptions {
+    fn default() -> Self {
+        Self {
+            every: 1,
+            fields: Field::ALL.to_vec(),
+            constants: Vec::new(),
+        }
+    }
 }
 
 /// What a [`RunWriter`] has written so far, saved with a checkpoint so
@@ -98,7 +156,13 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
             steps: CsvTable::new(&step_columns(D))?,
             iterations: CsvTable::new(&["step", "iteration", "normalised_residual"])?,
             tables: BTreeMap::new(),
+            options: VtuOptions::default(),
         })
+    }
+
+    /// Sets what the VTU files hold and how often they are written.
+    pub fn set_vtu_options(&mut self, options: VtuOptions) {
+        self.options = options;
     }
 
     /// A writer that continues the series and tables of `state` (a resumed
@@ -118,6 +182,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
             steps: state.steps,
             iterations: state.iterations,
             tables: state.tables,
+            options: VtuOptions::default(),
         })
     }
 
@@ -166,35 +231,10 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
                 .set_nodes(nodes)
                 .map_err(|source| CasesError::Mesh { source })?;
         }
-        let name = format!("points_{step:04}.vtu");
-        let path = self.dir.join(&name);
-        let mut vtu = UnstructuredGrid::new(&snap.position)?;
-        vtu.add_vertex_cells();
-        vtu.point_data("displacement", Values::vectors(&snap.displacement))?;
-        vtu.point_data("cauchy_stress", Values::tensors(&snap.sigma))?;
-        vtu.point_data("deformation_gradient", Values::tensors(&snap.f))?;
-        vtu.point_data("volume", Values::scalars(&snap.volume))?;
-        vtu.point_data(
-            "equivalent_plastic_strain",
-            Values::scalars(&snap.plastic_strain),
-        )?;
-        let (lower, upper): (Vec<[f64; 3]>, Vec<[f64; 3]>) =
-            snap.domain_bounds.iter().copied().unzip();
-        if !lower.is_empty() {
-            vtu.point_data("domain_lower", Values::vectors(&lower))?;
-            vtu.point_data("domain_upper", Values::vectors(&upper))?;
+        let last = report.lambda1 >= 1.0 - 1e-12;
+        if (step + 1) % self.options.every.max(1) == 0 || last {
+            self.write_vtu(step, report, snap)?;
         }
-        vtu.write(&path)?;
-        self.points.push(report.lambda1, &path)?;
-
-        if let Some(k) = &snap.tangent {
-            let path = self.dir.join(format!("tangent_{step:04}.mtx"));
-            atomic_write_with(&path, |w| sprs::io::write_matrix_market_to_bufwrite(w, k))?;
-        }
-        let grid_path = self.dir.join(format!("grid_{step:04}.vtu"));
-        self.write_active_grid(&grid_path, snap)?;
-        self.cells.push(report.lambda1, &grid_path)?;
-
         let mut row = vec![
             CsvValue::from(step),
             CsvValue::from(report.lambda1),
@@ -218,6 +258,59 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
             ])?;
         }
         self.iterations.write(&self.dir.join("iterations.csv"))
+    }
+
+    /// The VTU files (points and active grid) and the tangent of one step.
+    fn write_vtu(
+        &mut self,
+        step: usize,
+        report: &StepReport<D>,
+        snap: &Snapshot,
+    ) -> Result<(), CasesError> {
+        let name = format!("points_{step:04}.vtu");
+        let path = self.dir.join(&name);
+        let mut vtu = UnstructuredGrid::new(&snap.position)?;
+        vtu.add_vertex_cells();
+        let has = |f: Field| self.options.fields.contains(&f);
+        if has(Field::Displacement) {
+            vtu.point_data("displacement", Values::vectors(&snap.displacement))?;
+        }
+        if has(Field::Stress) {
+            vtu.point_data("cauchy_stress", Values::tensors(&snap.sigma))?;
+        }
+        if has(Field::DeformationGradient) {
+            vtu.point_data("deformation_gradient", Values::tensors(&snap.f))?;
+        }
+        if has(Field::Volume) {
+            vtu.point_data("volume", Values::scalars(&snap.volume))?;
+        }
+        if has(Field::PlasticStrain) {
+            vtu.point_data(
+                "equivalent_plastic_strain",
+                Values::scalars(&snap.plastic_strain),
+            )?;
+        }
+        let (lower, upper): (Vec<[f64; 3]>, Vec<[f64; 3]>) =
+            snap.domain_bounds.iter().copied().unzip();
+        if !lower.is_empty() && has(Field::Domain) {
+            vtu.point_data("domain_lower", Values::vectors(&lower))?;
+            vtu.point_data("domain_upper", Values::vectors(&upper))?;
+        }
+        if has(Field::Body) {
+            for (name, values) in &self.options.constants {
+                vtu.point_data(name, Values::scalars(values))?;
+            }
+        }
+        vtu.write(&path)?;
+        self.points.push(report.lambda1, &path)?;
+
+        if let Some(k) = &snap.tangent {
+            let path = self.dir.join(format!("tangent_{step:04}.mtx"));
+            atomic_write_with(&path, |w| sprs::io::write_matrix_market_to_bufwrite(w, k))?;
+        }
+        let grid_path = self.dir.join(format!("grid_{step:04}.vtu"));
+        self.write_active_grid(&grid_path, snap)?;
+        self.cells.push(report.lambda1, &grid_path)
     }
 
     /// The mesh cells holding material points.

@@ -60,6 +60,13 @@ pub enum ConstitutiveError {
         /// The value given.
         value: f64,
     },
+    /// A [`crate::MaterialSet`] needs at least one law and at most
+    /// `u32::MAX` of them.
+    #[error("a material set holds {count} laws; it needs 1 to 2^32 - 1")]
+    MaterialSetSize {
+        /// The number of laws given.
+        count: usize,
+    },
 }
 
 /// Shorthand for results of this crate.

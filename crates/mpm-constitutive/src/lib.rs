@@ -43,6 +43,7 @@ pub mod error;
 pub mod hencky;
 pub mod kinematics;
 pub mod law;
+pub mod material_set;
 pub mod spectral;
 pub mod tensor;
 pub mod verification;
@@ -55,6 +56,7 @@ pub use driver::{
 pub use error::{ConstitutiveError, Result};
 pub use hencky::HenckyElastic;
 pub use law::{IsotropicElasticity, LawState, LogStrainLaw};
+pub use material_set::{MaterialSet, Tagged};
 pub use spectral::{SymSpectral, sym_exp, sym_log};
 pub use tensor::Tensor4;
 pub use von_mises::{VonMises, VonMisesHistory};

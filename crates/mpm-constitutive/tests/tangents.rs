@@ -216,3 +216,12 @@ fn rotate_first_and_third(a: &Tensor4, q: &Matrix3<f64>) -> Tensor4 {
         v
     })
 }
+
+// A material set answers with the law of the point's tag (the default
+// history: material 0), so its tangents pass the same checks.
+mpm_constitutive::law_tangent_properties!(material_set_macro, |e, nu| {
+    mpm_constitutive::MaterialSet::new(vec![
+        mpm_constitutive::VonMises::new(e, nu, 1e-3 * e, 0.1 * e)?,
+        mpm_constitutive::VonMises::new(10.0 * e, nu, e, 0.0)?,
+    ])
+});

@@ -9,7 +9,7 @@
 //! [`MaterialPoints::from_flat`]).
 
 use mpm_basis::Corners;
-use mpm_constitutive::VonMisesHistory;
+use mpm_constitutive::{Tagged, VonMisesHistory};
 use nalgebra::{Matrix3, SVector};
 
 use crate::error::SolverError;
@@ -91,6 +91,27 @@ impl<T: Flat> Flat for (usize, T) {
     }
     fn read(from: &[f64]) -> Self {
         (from[0] as usize, T::read(&from[1..]))
+    }
+}
+
+/// The material index as a float (exact below 2^53, and a `u32` is), then
+/// the inner history. A negative, fractional or too large stored index
+/// reads as `u32::MAX`, which no material set contains
+/// (`MaterialSet::contains` then refuses it).
+impl<H: Flat> Flat for Tagged<H> {
+    const LEN: usize = 1 + H::LEN;
+    fn write(&self, out: &mut Vec<f64>) {
+        out.push(f64::from(self.material));
+        self.inner.write(out);
+    }
+    fn read(from: &[f64]) -> Self {
+        let m = from[0];
+        let material = if m >= 0.0 && m < f64::from(u32::MAX) && m.fract() == 0.0 {
+            m as u32
+        } else {
+            u32::MAX
+        };
+        Tagged::new(material, H::read(&from[1..]))
     }
 }
 

@@ -212,6 +212,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 .map_err(|source| retry(StepFailure::LinearSolve { source }, &monitor))?;
         }
         let reaction = convergence::reaction(&self.system, &self.it.f_int, &self.it.f_ext);
+        let node_reactions =
+            convergence::node_reactions(&self.system, &self.it.f_int, &self.it.f_ext);
         self.commit(points)?;
         // The mesh follows to the end of the step, with the points.
         self.move_mesh(lambda1)?;
@@ -222,6 +224,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             residuals: monitor.into_residuals(),
             initial_unbalance,
             reaction,
+            node_reactions,
             active_nodes: self.system.n_active(),
             free_dofs: self.system.n_free,
             factorisation: self.linear.last_factorisation(),

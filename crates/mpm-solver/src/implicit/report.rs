@@ -25,6 +25,11 @@ pub struct StepReport<const D: usize> {
     pub initial_unbalance: Option<f64>,
     /// Sum of the reactions at prescribed dofs, per component.
     pub reaction: SVector<f64, D>,
+    /// The reaction at every node with a prescribed dof, by mesh node id
+    /// (ascending): $f^{int} - f^{ext}$ at its prescribed components, zero
+    /// at its free ones. Sums over named node sets (a footing, a base)
+    /// come from it.
+    pub node_reactions: Vec<(usize, SVector<f64, D>)>,
     /// Active nodes, free dofs and stiffness entries of the step.
     pub active_nodes: usize,
     /// Free degrees of freedom.

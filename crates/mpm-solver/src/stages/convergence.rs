@@ -68,6 +68,32 @@ pub fn reaction<const D: usize>(
     r
 }
 
+/// The reaction at each active node with a prescribed dof (mesh id,
+/// ascending; zero at its free components).
+pub fn node_reactions<const D: usize>(
+    sys: &StepSystem<D>,
+    f_int: &[f64],
+    f_ext: &[f64],
+) -> Vec<(usize, SVector<f64, D>)> {
+    let mut out = Vec::new();
+    for v in 0..sys.n_active() {
+        let dofs = D * v..D * v + D;
+        if sys.free_of_dof[dofs.clone()].iter().all(|&f| f != NONE) {
+            continue;
+        }
+        let r = SVector::<f64, D>::from_fn(|i, _| {
+            let dof = D * v + i;
+            if sys.free_of_dof[dof] == NONE {
+                f_int[dof] - f_ext[dof]
+            } else {
+                0.0
+            }
+        });
+        out.push((sys.active[v], r));
+    }
+    out
+}
+
 /// What the convergence test says after an iteration.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Verdict {

@@ -1,0 +1,977 @@
+//! From a parsed [`Scene`] to what the solver takes: the grid, the
+//! material points of every body with their masses and materials, the
+//! Dirichlet conditions, the loads and the controls. Every check across
+//! sections happens here, before anything is run or written, and each
+//! error names the place in the file (or the override) it comes from.
+
+use std::collections::BTreeMap;
+
+use mpm_mesh::RegularGrid;
+use mpm_solver::{Constraints, LoadStepping, NewtonOptions};
+use nalgebra::SVector;
+use toml::Spanned;
+
+use crate::CasesError;
+use crate::material::{LawVisitor, MaterialModel, MaterialParams, dispatch_law};
+use crate::run::HistoryOutput;
+use crate::scene_file::SceneSource;
+use crate::variant::Variant;
+
+use super::format::{BoundaryKind, Field, LoadKind, Scene};
+use super::region::{Region, point};
+
+/// Largest number of grid nodes or material points a scene may ask for
+/// (a guard against a typo allocating the machine's memory).
+pub const MAX_ENTITIES: usize = 50_000_000;
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// The grid faces, as node-set names: `x_min`, `x_max`, `y_min`, …
+pub fn face_name(axis: usize, upper: bool) -> String {
+    format!("{}_{}", AXES[axis], if upper { "max" } else { "min" })
+}
+
+/// A piecewise-linear load curve, constant beyond its first and last rows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Curve {
+    /// `(time, factor)` rows, times strictly increasing; empty for the
+    /// default ramp (factor = load factor).
+    pub rows: Vec<[f64; 2]>,
+}
+
+impl Curve {
+    /// The default: the factor equals the load factor.
+    pub fn ramp() -> Self {
+        Self { rows: Vec::new() }
+    }
+
+    /// The factor at load factor `t`.
+    pub fn at(&self, t: f64) -> f64 {
+        let r = &self.rows;
+        let (Some(first), Some(last)) = (r.first(), r.last()) else {
+            return t;
+        };
+        if t <= first[0] {
+            return first[1];
+        }
+        if t >= last[0] {
+            return last[1];
+        }
+        let k = r.partition_point(|row| row[0] <= t);
+        let (a, b) = (r[k - 1], r[k]);
+        a[1] + (t - a[0]) / (b[0] - a[0]) * (b[1] - a[1])
+    }
+}
+
+/// Dirichlet conditions of a scene: per dof, the displacement reached
+/// where its curve is 1 and the curve.
+#[derive(Debug, Clone)]
+pub struct SceneConstraints<const D: usize> {
+    /// Per mesh dof `D * node + i`: `(displacement, curve index)`.
+    dofs: Vec<Option<(f64, u16)>>,
+    curves: Vec<Curve>,
+}
+
+impl<const D: usize> SceneConstraints<D> {
+    /// Number of prescribed dofs.
+    pub fn len(&self) -> usize {
+        self.dofs.iter().filter(|d| d.is_some()).count()
+    }
+
+    /// Whether nothing is prescribed.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl<const D: usize> Constraints<D> for SceneConstraints<D> {
+    #[inline]
+    fn prescribed(&self, node: usize, component: usize, lambda0: f64, lambda1: f64) -> Option<f64> {
+        let (u, curve) = (*self.dofs.get(node * D + component)?)?;
+        if u == 0.0 {
+            return Some(0.0);
+        }
+        let c = &self.curves[curve as usize];
+        Some(u * (c.at(lambda1) - c.at(lambda0)))
+    }
+}
+
+/// One body of the built scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BuiltBody {
+    /// Its name.
+    pub name: String,
+    /// Index into [`Problem::materials`].
+    pub material: usize,
+    /// Its points: `points` of the problem's arrays.
+    pub points: std::ops::Range<usize>,
+    /// Lattice step of its points per axis.
+    pub step: Vec<f64>,
+}
+
+/// A material as built: its model after promotion (see
+/// [`Problem::materials`]) and parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BuiltMaterial {
+    /// Name.
+    pub name: String,
+    /// Model the solver runs.
+    pub model: MaterialModel,
+    /// Parameters.
+    pub params: MaterialParams,
+    /// Density.
+    pub density: f64,
+}
+
+/// Forces that follow one load curve: the curve and the force on every
+/// point where the curve is 1.
+#[derive(Debug, Clone)]
+pub struct CurvedForces<const D: usize> {
+    /// The curve.
+    pub curve: Curve,
+    /// Force per point (all points of the scene).
+    pub force: Vec<SVector<f64, D>>,
+}
+
+/// A scene ready to run.
+#[derive(Debug, Clone)]
+pub struct Problem<const D: usize> {
+    /// The grid, padding included.
+    pub grid: RegularGrid<D>,
+    /// Padding cells on every side.
+    pub padding: usize,
+    /// The bodies, in file order; their points are consecutive.
+    pub bodies: Vec<BuiltBody>,
+    /// The materials, in file order. When the bodies use different models,
+    /// every material runs with the most general one: a `hencky` material
+    /// in a scene with `von_mises` ones is von Mises with an infinite yield
+    /// stress, which never yields and answers with Hencky's stress and
+    /// tangent.
+    pub materials: Vec<BuiltMaterial>,
+    /// Point positions.
+    pub position: Vec<SVector<f64, D>>,
+    /// Point volumes.
+    pub volume: Vec<f64>,
+    /// Point domain half-lengths.
+    pub half_lengths: Vec<SVector<f64, D>>,
+    /// Point masses.
+    pub mass: Vec<f64>,
+    /// Material index of every point.
+    pub material_of_point: Vec<u32>,
+    /// Body index of every point.
+    pub body_of_point: Vec<u32>,
+    /// Dirichlet conditions.
+    pub constraints: SceneConstraints<D>,
+    /// Proportional body force per point (empty if none).
+    pub body_force: Vec<SVector<f64, D>>,
+    /// Proportional point forces.
+    pub point_forces: Vec<(usize, SVector<f64, D>)>,
+    /// Forces following load curves.
+    pub curved: Vec<CurvedForces<D>>,
+    /// Load stepping.
+    pub stepping: LoadStepping,
+    /// Newton controls.
+    pub newton: NewtonOptions,
+    /// The variant.
+    pub variant: Variant,
+    /// Reaction histories: name and the set's mesh nodes (sorted).
+    pub reactions: Vec<(String, Vec<usize>)>,
+    /// Probes: name and the point nearest the location.
+    pub probes: Vec<(String, usize)>,
+    /// VTU files every this many steps.
+    pub every: usize,
+    /// VTU fields.
+    pub fields: Vec<Field>,
+    /// Write a PNG of the final state.
+    pub png: bool,
+}
+
+/// Lengths, positivity and finiteness checks with located errors.
+struct Check<'a> {
+    src: &'a SceneSource,
+}
+
+impl Check<'_> {
+    fn positive(&self, v: &Spanned<f64>, what: &str) -> Result<f64, CasesError> {
+        let x = *v.get_ref();
+        if x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.src.at(v, format!("{what} must be positive, got {x}")))
+        }
+    }
+
+    fn at_least(&self, v: &Spanned<usize>, min: usize, what: &str) -> Result<usize, CasesError> {
+        let x = *v.get_ref();
+        if x >= min {
+            Ok(x)
+        } else {
+            Err(self.src.at(v, format!("{what} must be at least {min}, got {x}")))
+        }
+    }
+}
+
+/// Unique names of a section, or an error at the second use.
+fn unique_names<'a>(
+    names: impl Iterator<Item = &'a Spanned<String>>,
+    section: &str,
+    src: &SceneSource,
+) -> Result<BTreeMap<String, usize>, CasesError> {
+    let mut map = BTreeMap::new();
+    for (k, name) in names.enumerate() {
+        if name.get_ref().is_empty() {
+            return Err(src.at(name, format!("a {section} needs a non-empty name")));
+        }
+        if map.insert(name.get_ref().clone(), k).is_some() {
+            return Err(src.at(
+                name,
+                format!("a second {section} named `{}`", name.get_ref()),
+            ));
+        }
+    }
+    Ok(map)
+}
+
+/// `name` looked up in `map`, or an error listing the names there are.
+fn lookup(
+    map: &BTreeMap<String, usize>,
+    name: &Spanned<String>,
+    section: &str,
+    src: &SceneSource,
+) -> Result<usize, CasesError> {
+    map.get(name.get_ref()).copied().ok_or_else(|| {
+        let known: Vec<&str> = map.keys().map(String::as_str).collect();
+        src.at(
+            name,
+            format!(
+                "no {section} named `{}`; the scene has: {}",
+                name.get_ref(),
+                if known.is_empty() {
+                    "none".to_owned()
+                } else {
+                    known.join(", ")
+                }
+            ),
+        )
+    })
+}
+
+/// Checks that a law can be built from `params`.
+struct Validate;
+
+impl LawVisitor for Validate {
+    type Output = ();
+    fn visit<L>(self, _law: L)
+    where
+        L: mpm_constitutive::LogStrainLaw,
+        L::History: HistoryOutput + mpm_solver::Flat,
+    {
+    }
+}
+
+impl<const D: usize> Problem<D> {
+    /// Builds the scene for a basis that needs `basis_padding` cells of
+    /// padding.
+    ///
+    /// # Errors
+    /// [`CasesError::Scene`] (or [`CasesError::Override`]) at the value
+    /// that is wrong, [`CasesError::SceneUnlocated`] for what has no single
+    /// place.
+    pub fn build(scene: &Scene, src: &SceneSource, basis_padding: usize) -> Result<Self, CasesError> {
+        let check = Check { src };
+        let variant = Variant {
+            basis: scene.solver.basis,
+            formulation: scene.solver.formulation,
+            locking: scene.solver.locking,
+            domain_update: scene.solver.domain_update,
+            gimp_volume: scene.solver.gimp_volume,
+        };
+
+        // Mesh.
+        let m = &scene.mesh;
+        let origin = point::<D>(&m.origin, "mesh `origin`", src)?;
+        let size = point::<D>(&m.size, "mesh `size`", src)?;
+        if let Some(axis) = (0..D).find(|&i| size[i] <= 0.0) {
+            return Err(src.at(
+                &m.size,
+                format!("mesh `size` must be positive on every axis ({} is {})", AXES[axis], size[axis]),
+            ));
+        }
+        let cells: [usize; D] = match (&m.cells, &m.spacing) {
+            (Some(c), None) => {
+                if c.get_ref().len() != D {
+                    return Err(src.at(
+                        c,
+                        format!("mesh `cells` has {} entries; the scene is {D}D", c.get_ref().len()),
+                    ));
+                }
+                if c.get_ref().contains(&0) {
+                    return Err(src.at(c, "mesh `cells` must be at least 1 on every axis"));
+                }
+                std::array::from_fn(|i| c.get_ref()[i])
+            }
+            (None, Some(h)) => {
+                let h_v = point::<D>(h, "mesh `spacing`", src)?;
+                let mut cells = [0usize; D];
+                for i in 0..D {
+                    let n = size[i] / h_v[i];
+                    if !(h_v[i] > 0.0 && n.is_finite() && n >= 0.5 && (n - n.round()).abs() <= 1e-9 * n.max(1.0)) {
+                        return Err(src.at(
+                            h,
+                            format!(
+                                "mesh `spacing` {} must be positive and divide the size {} along {}",
+                                h_v[i], size[i], AXES[i]
+                            ),
+                        ));
+                    }
+                    cells[i] = n.round() as usize;
+                }
+                cells
+            }
+            (Some(c), Some(_)) => {
+                return Err(src.at(c, "give mesh `cells` or `spacing`, not both"));
+            }
+            (None, None) => {
+                return Err(src.at(&m.size, "the mesh needs `cells` or `spacing`"));
+            }
+        };
+        let padding = match &m.padding {
+            Some(p) if *p.get_ref() < basis_padding => {
+                return Err(src.at(
+                    p,
+                    format!(
+                        "basis = {} needs {basis_padding} padding cell(s), got {}",
+                        variant.basis,
+                        p.get_ref()
+                    ),
+                ));
+            }
+            Some(p) => *p.get_ref(),
+            None => basis_padding,
+        };
+        let spacing = SVector::<f64, D>::from_fn(|i, _| size[i] / cells[i] as f64);
+        let padded: [usize; D] = std::array::from_fn(|i| cells[i].saturating_add(2 * padding));
+        let nodes = padded
+            .iter()
+            .try_fold(1usize, |n, &c| n.checked_mul(c.saturating_add(1)));
+        if nodes.is_none_or(|n| n > MAX_ENTITIES) {
+            return Err(src.at(
+                m.cells.as_ref().map_or(&m.size, |_| &m.size),
+                format!("the grid would have more than {MAX_ENTITIES} nodes"),
+            ));
+        }
+        let grid = RegularGrid::new(
+            origin - spacing * padding as f64,
+            spacing,
+            padded,
+        )
+        .map_err(|e| src.at(&m.origin, format!("mesh: {e}")))?;
+        let upper = origin + size;
+        let tol = 1e-9 * size.max();
+
+        // Curves (index 0: the default ramp).
+        let curve_names = unique_names(scene.curves.iter().map(|c| &c.name), "curve", src)?;
+        let mut curves = vec![Curve::ramp()];
+        for c in &scene.curves {
+            let rows = c.points.get_ref();
+            if rows.is_empty() {
+                return Err(src.at(&c.points, "a curve needs at least one [time, factor] row"));
+            }
+            if let Some(k) = (1..rows.len()).find(|&k| rows[k][0] <= rows[k - 1][0]) {
+                return Err(src.at(
+                    &c.points,
+                    format!(
+                        "curve `{}`: times must increase, but row {} has time {} after {}",
+                        c.name.get_ref(),
+                        k + 1,
+                        rows[k][0],
+                        rows[k - 1][0]
+                    ),
+                ));
+            }
+            curves.push(Curve { rows: rows.clone() });
+        }
+        if curves.len() > u16::MAX as usize {
+            return Err(src.error(None, "too many curves"));
+        }
+        let curve_of = |name: &Option<Spanned<String>>| -> Result<usize, CasesError> {
+            match name {
+                None => Ok(0),
+                Some(n) => lookup(&curve_names, n, "curve", src).map(|k| k + 1),
+            }
+        };
+
+        // Materials.
+        let material_names = unique_names(scene.materials.iter().map(|m| &m.name), "material", src)?;
+        if scene.materials.is_empty() {
+            return Err(src.error(None, "a scene needs at least one [[material]]"));
+        }
+        let plastic = scene
+            .materials
+            .iter()
+            .any(|m| m.model == MaterialModel::VonMises);
+        let mut materials = Vec::new();
+        for spec in &scene.materials {
+            let density = *spec.density.get_ref();
+            if density < 0.0 {
+                return Err(src.at(&spec.density, "density must be non-negative"));
+            }
+            let mut params = MaterialParams {
+                youngs_modulus: spec.youngs_modulus,
+                poisson_ratio: spec.poisson_ratio,
+                yield_stress: spec.yield_stress,
+                hardening: spec.hardening,
+            };
+            if spec.model != MaterialModel::VonMises && spec.yield_stress.is_some() {
+                return Err(src.at(
+                    &spec.name,
+                    format!("material `{}`: yield_stress applies to model = von_mises", spec.name.get_ref()),
+                ));
+            }
+            dispatch_law(spec.model, &params, Validate)
+                .map_err(|e| src.at(&spec.name, format!("material `{}`: {e}", spec.name.get_ref())))?;
+            let model = if plastic && spec.model == MaterialModel::Hencky {
+                params.yield_stress = Some(f64::MAX);
+                params.hardening = 0.0;
+                MaterialModel::VonMises
+            } else {
+                spec.model
+            };
+            materials.push(BuiltMaterial {
+                name: spec.name.get_ref().clone(),
+                model,
+                params,
+                density,
+            });
+        }
+
+        // Bodies.
+        if scene.bodies.is_empty() {
+            return Err(src.error(None, "a scene needs at least one [[body]]"));
+        }
+        unique_names(scene.bodies.iter().map(|b| &b.name), "body", src)?;
+        let mut regions = Vec::new();
+        let mut problem_points = Points::<D>::default();
+        let mut bodies = Vec::new();
+        for (b, spec) in scene.bodies.iter().enumerate() {
+            let material = lookup(&material_names, &spec.material, "material", src)?;
+            let region = Region::<D>::new(&spec.region, src)?;
+            let (lo, hi) = region.bounds();
+            if (0..D).any(|i| lo[i] < origin[i] - tol || hi[i] > upper[i] + tol) {
+                return Err(src.at(
+                    &spec.name,
+                    format!(
+                        "body `{}` reaches outside the mesh: its region spans {:?} to {:?}, the mesh {:?} to {:?}",
+                        spec.name.get_ref(),
+                        lo.as_slice(),
+                        hi.as_slice(),
+                        origin.as_slice(),
+                        upper.as_slice()
+                    ),
+                ));
+            }
+            let ppc = check.at_least(&spec.points_per_cell, 1, "points_per_cell")?;
+            let start = problem_points.position.len();
+            let step = problem_points.fill(&grid, padding, cells, &region, ppc, src, &spec.points_per_cell)?;
+            let end = problem_points.position.len();
+            if end == start {
+                return Err(src.at(
+                    &spec.name,
+                    format!(
+                        "body `{}` holds no material points: no sub-cell centre at {ppc} points per cell lies in its region",
+                        spec.name.get_ref()
+                    ),
+                ));
+            }
+            for p in start..end {
+                if let Some(other) = regions
+                    .iter()
+                    .position(|r: &Region<D>| r.contains(&problem_points.position[p]))
+                {
+                    return Err(src.at(
+                        &spec.name,
+                        format!(
+                            "body `{}` overlaps body `{}` (both hold {:?}); bodies may touch but not overlap",
+                            spec.name.get_ref(),
+                            scene.bodies[other].name.get_ref(),
+                            problem_points.position[p].as_slice()
+                        ),
+                    ));
+                }
+            }
+            let density = materials[material].density;
+            for p in start..end {
+                problem_points.mass.push(problem_points.volume[p] * density);
+                problem_points.material.push(material as u32);
+                problem_points.body.push(b as u32);
+            }
+            regions.push(region);
+            bodies.push(BuiltBody {
+                name: spec.name.get_ref().clone(),
+                material,
+                points: start..end,
+                step: step.as_slice().to_vec(),
+            });
+        }
+        let body_names: BTreeMap<String, usize> = bodies
+            .iter()
+            .enumerate()
+            .map(|(k, b)| (b.name.clone(), k))
+            .collect();
+        let n = problem_points.position.len();
+
+        // Node sets: the faces, then the named ones.
+        let mut sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+        let node_position = |v: usize| grid.node_position(v).unwrap_or_else(|_| SVector::zeros());
+        for axis in 0..D {
+            for upper_face in [false, true] {
+                let bound = if upper_face { upper[axis] } else { origin[axis] };
+                let nodes = (0..grid.node_count())
+                    .filter(|&v| {
+                        let x = node_position(v)[axis];
+                        if upper_face { x >= bound - tol } else { x <= bound + tol }
+                    })
+                    .collect();
+                sets.insert(face_name(axis, upper_face), nodes);
+            }
+        }
+        let faces: Vec<String> = sets.keys().cloned().collect();
+        for spec in &scene.node_sets {
+            if sets.contains_key(spec.name.get_ref()) {
+                return Err(src.at(
+                    &spec.name,
+                    format!("node set `{}` is already defined (a grid face or an earlier set)", spec.name.get_ref()),
+                ));
+            }
+            let region = Region::<D>::new(&spec.region, src)?;
+            let nodes: Vec<usize> = (0..grid.node_count())
+                .filter(|&v| region.contains(&node_position(v)))
+                .collect();
+            if nodes.is_empty() {
+                return Err(src.at(
+                    &spec.name,
+                    format!("node set `{}` holds no grid node", spec.name.get_ref()),
+                ));
+            }
+            sets.insert(spec.name.get_ref().clone(), nodes);
+        }
+        let set_of = |name: &Spanned<String>| -> Result<&Vec<usize>, CasesError> {
+            sets.get(name.get_ref()).ok_or_else(|| {
+                src.at(
+                    name,
+                    format!(
+                        "no node set named `{}`; the scene has: {}",
+                        name.get_ref(),
+                        sets.keys().cloned().collect::<Vec<_>>().join(", ")
+                    ),
+                )
+            })
+        };
+
+        // Boundaries (later conditions replace earlier ones on shared dofs).
+        let mut dofs: Vec<Option<(f64, u16)>> = vec![None; grid.node_count() * D];
+        for spec in &scene.boundaries {
+            let nodes = set_of(&spec.set)?;
+            let mut prescribe = |component: usize, value: f64, curve: usize| {
+                for &v in nodes {
+                    dofs[v * D + component] = Some((value, curve as u16));
+                }
+            };
+            let not_here = |what: &str, kind: &str| {
+                src.at(&spec.kind, format!("`{what}` applies to kind = displacement, not {kind}"))
+            };
+            match spec.kind.get_ref() {
+                BoundaryKind::Fixed | BoundaryKind::Roller => {
+                    let kind = if *spec.kind.get_ref() == BoundaryKind::Fixed { "fixed" } else { "roller" };
+                    if spec.displacement.is_some() {
+                        return Err(not_here("displacement", kind));
+                    }
+                    if spec.curve.is_some() {
+                        return Err(not_here("curve", kind));
+                    }
+                    if *spec.kind.get_ref() == BoundaryKind::Fixed {
+                        (0..D).for_each(|i| prescribe(i, 0.0, 0));
+                    } else {
+                        let axis = (0..D).find(|&i| {
+                            [face_name(i, false), face_name(i, true)].contains(spec.set.get_ref())
+                        });
+                        let Some(axis) = axis else {
+                            return Err(src.at(
+                                &spec.set,
+                                format!(
+                                    "a roller needs a grid face for its normal ({}); `{}` is not one",
+                                    faces.join(", "),
+                                    spec.set.get_ref()
+                                ),
+                            ));
+                        };
+                        prescribe(axis, 0.0, 0);
+                    }
+                }
+                BoundaryKind::Displacement => {
+                    let Some(d) = &spec.displacement else {
+                        return Err(src.at(&spec.kind, "kind = displacement needs `displacement = { x = …, y = … }`"));
+                    };
+                    let curve = curve_of(&spec.curve)?;
+                    let values = d.get_ref().get();
+                    if let Some(axis) = (D..3).find(|&i| values[i].is_some()) {
+                        return Err(src.at(d, format!("a {D}D scene has no {} component", AXES[axis])));
+                    }
+                    if values.iter().all(Option::is_none) {
+                        return Err(src.at(d, "`displacement` needs at least one of x, y, z"));
+                    }
+                    for (i, v) in values.iter().take(D).enumerate() {
+                        if let Some(v) = v {
+                            prescribe(i, *v, curve);
+                        }
+                    }
+                }
+                BoundaryKind::Velocity => {
+                    return Err(src.at(
+                        &spec.kind,
+                        "kind = velocity needs the explicit solver; the implicit solver prescribes displacements (kind = displacement)",
+                    ));
+                }
+            }
+        }
+        let constraints = SceneConstraints {
+            dofs,
+            curves: curves.clone(),
+        };
+
+        // Loads.
+        let mut body_force: Vec<SVector<f64, D>> = Vec::new();
+        let mut point_forces = Vec::new();
+        let mut curved: BTreeMap<usize, Vec<SVector<f64, D>>> = BTreeMap::new();
+        let nearest = |x: &SVector<f64, D>| -> usize {
+            (0..n)
+                .min_by(|&a, &b| {
+                    let (da, db) = (
+                        (problem_points.position[a] - x).norm_squared(),
+                        (problem_points.position[b] - x).norm_squared(),
+                    );
+                    da.total_cmp(&db)
+                })
+                .unwrap_or(0)
+        };
+        for spec in &scene.loads {
+            let kind = *spec.kind.get_ref();
+            let curve = curve_of(&spec.curve)?;
+            let refuse = |key: &str, applies: &str| {
+                src.at(&spec.kind, format!("`{key}` applies to kind = {applies} loads"))
+            };
+            // Keys that belong to other kinds.
+            let present: [(&str, bool, LoadKind); 6] = [
+                ("acceleration", spec.acceleration.is_some(), LoadKind::Gravity),
+                ("force", spec.force.is_some(), LoadKind::Point),
+                ("at", spec.at.is_some(), LoadKind::Point),
+                ("region", spec.region.is_some(), LoadKind::Point),
+                ("traction", spec.traction.is_some(), LoadKind::Traction),
+                ("side", spec.side.is_some(), LoadKind::Traction),
+            ];
+            for (key, given, owner) in present {
+                if given && owner != kind {
+                    let name = match owner {
+                        LoadKind::Gravity => "gravity",
+                        LoadKind::Point => "point",
+                        LoadKind::Traction => "traction",
+                    };
+                    return Err(refuse(key, name));
+                }
+            }
+            let mut forces = vec![SVector::<f64, D>::zeros(); 0];
+            let add = |p: usize, f: SVector<f64, D>, forces: &mut Vec<SVector<f64, D>>| {
+                if forces.is_empty() {
+                    forces.resize(n, SVector::zeros());
+                }
+                forces[p] += f;
+            };
+            match kind {
+                LoadKind::Gravity => {
+                    let Some(a) = &spec.acceleration else {
+                        return Err(src.at(&spec.kind, "a gravity load needs `acceleration`"));
+                    };
+                    let g = point::<D>(a, "`acceleration`", src)?;
+                    let range = match &spec.body {
+                        Some(b) => bodies[lookup(&body_names, b, "body", src)?].points.clone(),
+                        None => 0..n,
+                    };
+                    for p in range {
+                        add(p, g * problem_points.mass[p], &mut forces);
+                    }
+                }
+                LoadKind::Point => {
+                    if spec.body.is_some() {
+                        return Err(refuse("body", "gravity or traction"));
+                    }
+                    let Some(f) = &spec.force else {
+                        return Err(src.at(&spec.kind, "a point load needs `force`"));
+                    };
+                    let f = point::<D>(f, "`force`", src)?;
+                    match (&spec.at, &spec.region) {
+                        (Some(at), None) => {
+                            let x = point::<D>(at, "`at`", src)?;
+                            add(nearest(&x), f, &mut forces);
+                        }
+                        (None, Some(r)) => {
+                            let region = Region::<D>::new(r, src)?;
+                            let inside: Vec<usize> = (0..n)
+                                .filter(|&p| region.contains(&problem_points.position[p]))
+                                .collect();
+                            if inside.is_empty() {
+                                return Err(src.at(&spec.kind, "the point load's region holds no material point"));
+                            }
+                            let share = f / inside.len() as f64;
+                            for p in inside {
+                                add(p, share, &mut forces);
+                            }
+                        }
+                        _ => {
+                            return Err(src.at(&spec.kind, "a point load needs one of `at` or `region`"));
+                        }
+                    }
+                }
+                LoadKind::Traction => {
+                    let (Some(t), Some(side), Some(b)) = (&spec.traction, &spec.side, &spec.body) else {
+                        return Err(src.at(&spec.kind, "a traction load needs `traction`, `side` and `body`"));
+                    };
+                    let t = point::<D>(t, "`traction`", src)?;
+                    let k = lookup(&body_names, b, "body", src)?;
+                    let face = (0..D)
+                        .flat_map(|i| [(i, false), (i, true)])
+                        .find(|&(i, up)| face_name(i, up) == *side.get_ref());
+                    let Some((axis, up)) = face else {
+                        return Err(src.at(
+                            side,
+                            format!("`side` must be one of {}", faces.join(", ")),
+                        ));
+                    };
+                    let body = &bodies[k];
+                    let mut offset = SVector::<f64, D>::zeros();
+                    offset[axis] = if up { body.step[axis] } else { -body.step[axis] };
+                    let mut loaded = 0;
+                    for p in body.points.clone() {
+                        let x = problem_points.position[p];
+                        if !regions[k].contains(&(x + offset)) {
+                            // The point's face area on that side.
+                            let area = problem_points.volume[p] / body.step[axis];
+                            add(p, t * area, &mut forces);
+                            loaded += 1;
+                        }
+                    }
+                    if loaded == 0 {
+                        return Err(src.at(side, format!("body `{}` has no points on side {}", body.name, side.get_ref())));
+                    }
+                }
+            }
+            if forces.is_empty() {
+                continue;
+            }
+            if curve == 0 {
+                if kind == LoadKind::Point {
+                    point_forces.extend(
+                        forces
+                            .iter()
+                            .enumerate()
+                            .filter(|(_, f)| **f != SVector::<f64, D>::zeros())
+                            .map(|(p, f)| (p, *f)),
+                    );
+                } else if body_force.is_empty() {
+                    body_force = forces;
+                } else {
+                    body_force.iter_mut().zip(&forces).for_each(|(a, b)| *a += b);
+                }
+            } else {
+                let entry = curved.entry(curve).or_insert_with(|| vec![SVector::zeros(); n]);
+                entry.iter_mut().zip(&forces).for_each(|(a, b)| *a += b);
+            }
+        }
+        let curved = curved
+            .into_iter()
+            .map(|(k, force)| CurvedForces {
+                curve: curves[k].clone(),
+                force,
+            })
+            .collect();
+
+        // Solver.
+        let s = &scene.solver;
+        let steps = check.at_least(&s.steps, 1, "solver `steps`")?;
+        let initial = 1.0 / steps as f64;
+        let max = match &s.max_increment {
+            Some(v) => check.positive(v, "solver `max_increment`")?,
+            None => initial,
+        };
+        let min = match &s.min_increment {
+            Some(v) => check.positive(v, "solver `min_increment`")?,
+            None => initial / 1024.0,
+        };
+        if !(min <= initial && initial <= max && max <= 1.0) {
+            let at = s.max_increment.as_ref().or(s.min_increment.as_ref());
+            return Err(src.error(
+                at.map(Spanned::span),
+                &format!("load increments need min_increment ({min}) <= 1/steps ({initial}) <= max_increment ({max}) <= 1"),
+            ));
+        }
+        let tolerance = check.positive(&s.tolerance, "solver `tolerance`")?;
+        let max_iterations = check.at_least(&s.max_iterations, 1, "solver `max_iterations`")?;
+
+        // Outputs.
+        let o = &scene.output;
+        let every = check.at_least(&o.every, 1, "output `every`")?;
+        let safe = |name: &Spanned<String>| -> Result<String, CasesError> {
+            let v = name.get_ref();
+            if v.is_empty() || !v.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+                return Err(src.at(name, "an output name must be letters, digits, `_` or `-` (it names a file)"));
+            }
+            Ok(v.clone())
+        };
+        unique_names(o.reactions.iter().map(|r| &r.name), "reaction output", src)?;
+        unique_names(o.probes.iter().map(|r| &r.name), "probe output", src)?;
+        let reactions = o
+            .reactions
+            .iter()
+            .map(|r| Ok((safe(&r.name)?, set_of(&r.set)?.clone())))
+            .collect::<Result<Vec<_>, CasesError>>()?;
+        let probes = o
+            .probes
+            .iter()
+            .map(|p| Ok((safe(&p.name)?, nearest(&point::<D>(&p.at, "probe `at`", src)?))))
+            .collect::<Result<Vec<_>, CasesError>>()?;
+        if o.png && D != 2 {
+            return Err(src.error(None, "output `png` draws 2D scenes only"));
+        }
+        let fields = o.fields.clone().unwrap_or_else(|| {
+            vec![
+                Field::Displacement,
+                Field::Stress,
+                Field::DeformationGradient,
+                Field::Volume,
+                Field::PlasticStrain,
+                Field::Domain,
+                Field::Body,
+            ]
+        });
+
+        Ok(Self {
+            grid,
+            padding,
+            bodies,
+            materials,
+            position: problem_points.position,
+            volume: problem_points.volume,
+            half_lengths: problem_points.half_lengths,
+            mass: problem_points.mass,
+            material_of_point: problem_points.material,
+            body_of_point: problem_points.body,
+            constraints,
+            body_force,
+            point_forces,
+            curved,
+            stepping: LoadStepping { initial, max, min },
+            newton: NewtonOptions {
+                tolerance,
+                max_iterations,
+                ..NewtonOptions::default()
+            },
+            variant,
+            reactions,
+            probes,
+            every,
+            fields,
+            png: o.png,
+        })
+    }
+
+    /// Number of material points.
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    /// Whether the scene has no points (never, once built).
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+}
+
+/// Point arrays while the bodies are filled.
+#[derive(Default)]
+struct Points<const D: usize> {
+    position: Vec<SVector<f64, D>>,
+    volume: Vec<f64>,
+    half_lengths: Vec<SVector<f64, D>>,
+    mass: Vec<f64>,
+    material: Vec<u32>,
+    body: Vec<u32>,
+}
+
+impl<const D: usize> Points<D> {
+    /// Adds the sub-cell centres (`ppc` per axis per cell of the unpadded
+    /// grid) that lie in `region`; returns the lattice step.
+    #[allow(clippy::too_many_arguments)]
+    fn fill(
+        &mut self,
+        grid: &RegularGrid<D>,
+        padding: usize,
+        cells: [usize; D],
+        region: &Region<D>,
+        ppc: usize,
+        src: &SceneSource,
+        ppc_span: &Spanned<usize>,
+    ) -> Result<SVector<f64, D>, CasesError> {
+        let h = *grid.spacing();
+        let step = h / ppc as f64;
+        let origin = grid.origin() + h * padding as f64;
+        // Only the lattice over the region's bounding box is visited.
+        let (lo, hi) = region.bounds();
+        let mut first = [0usize; D];
+        let mut count = [0usize; D];
+        for i in 0..D {
+            let per_axis = cells[i].saturating_mul(ppc);
+            let a = ((lo[i] - origin[i]) / step[i]).floor().max(0.0) as usize;
+            let b = (((hi[i] - origin[i]) / step[i]).ceil().max(0.0) as usize).min(per_axis);
+            first[i] = a.min(per_axis);
+            count[i] = b.saturating_sub(first[i]);
+        }
+        let total = count.iter().try_fold(1usize, |n, &c| n.checked_mul(c));
+        if total.is_none_or(|t| t.saturating_add(self.position.len()) > MAX_ENTITIES) {
+            return Err(src.at(
+                ppc_span,
+                format!("the scene would hold more than {MAX_ENTITIES} material points"),
+            ));
+        }
+        let volume = step.iter().product::<f64>();
+        for flat in 0..total.unwrap_or(0) {
+            let mut rest = flat;
+            let mut x = SVector::<f64, D>::zeros();
+            for i in 0..D {
+                let k = first[i] + rest % count[i];
+                rest /= count[i];
+                x[i] = origin[i] + (k as f64 + 0.5) * step[i];
+            }
+            if region.contains(&x) {
+                self.position.push(x);
+                self.volume.push(volume);
+                self.half_lengths.push(step / 2.0);
+            }
+        }
+        Ok(step)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn curves_interpolate_and_hold_beyond_their_ends() {
+        let c = Curve {
+            rows: vec![[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]],
+        };
+        assert_eq!(c.at(-1.0), 0.0);
+        assert_eq!(c.at(0.25), 0.5);
+        assert_eq!(c.at(0.75), 1.0);
+        assert_eq!(c.at(2.0), 1.0);
+        assert_eq!(Curve::ramp().at(0.3), 0.3);
+    }
+}

@@ -1,0 +1,386 @@
+//! The scene file format: what a TOML scene deserialises into, before any
+//! check across sections (names that refer to nothing, bodies outside the
+//! mesh; [`super::build`]). Every table refuses unknown keys. Fields that
+//! other sections refer to, or whose value is checked later, keep their
+//! place in the file (`Spanned`) so that the error can name it.
+//!
+//! The guide page `docs/src/guide/scenes.md` documents every key.
+
+use serde::{Deserialize, Serialize};
+use toml::Spanned;
+
+use crate::material::MaterialModel;
+use crate::variant::{BasisKind, DomainUpdateKind, FormulationKind, GimpVolumeKind, LockingKind};
+
+/// A whole problem: mesh, materials, bodies, conditions, loads, solver
+/// and outputs.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Free text describing the scene (copied to `summary.json`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub description: Option<String>,
+    /// The background mesh.
+    pub mesh: MeshSpec,
+    /// The materials, referred to by name from the bodies.
+    #[serde(rename = "material")]
+    pub materials: Vec<MaterialSpec>,
+    /// The bodies of material points.
+    #[serde(rename = "body")]
+    pub bodies: Vec<BodySpec>,
+    /// Named node sets besides the grid faces.
+    #[serde(rename = "node_set", default, skip_serializing_if = "Vec::is_empty")]
+    pub node_sets: Vec<NodeSetSpec>,
+    /// Dirichlet conditions on node sets.
+    #[serde(rename = "boundary", default, skip_serializing_if = "Vec::is_empty")]
+    pub boundaries: Vec<BoundarySpec>,
+    /// Loads.
+    #[serde(rename = "load", default, skip_serializing_if = "Vec::is_empty")]
+    pub loads: Vec<LoadSpec>,
+    /// Load curves, referred to by name from loads and boundaries.
+    #[serde(rename = "curve", default, skip_serializing_if = "Vec::is_empty")]
+    pub curves: Vec<CurveSpec>,
+    /// The solver and its variant.
+    #[serde(default)]
+    pub solver: SolverSpec,
+    /// What is written.
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+/// Kinds of background mesh.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MeshKind {
+    /// A regular grid of squares or cubes.
+    #[default]
+    Grid,
+}
+
+/// `[mesh]`: a regular grid over the box `origin .. origin + size`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// The kind of mesh (`grid`).
+    #[serde(default)]
+    pub kind: MeshKind,
+    /// Lower corner (m); its length (2 or 3) sets the dimension.
+    pub origin: Spanned<Vec<f64>>,
+    /// Extent per axis (m).
+    pub size: Spanned<Vec<f64>>,
+    /// Cells per axis (give this or `spacing`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cells: Option<Spanned<Vec<usize>>>,
+    /// Cell size per axis (m), dividing `size` (give this or `cells`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spacing: Option<Spanned<Vec<f64>>>,
+    /// Extra cells on every side beyond the box; at least what the basis
+    /// needs (one for quadratic B-splines), which is also the default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub padding: Option<Spanned<usize>>,
+}
+
+/// `[[material]]`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Name the bodies use.
+    pub name: Spanned<String>,
+    /// Constitutive model.
+    pub model: MaterialModel,
+    /// Young's modulus E (Pa).
+    pub youngs_modulus: f64,
+    /// Poisson's ratio ν.
+    pub poisson_ratio: f64,
+    /// Density ϱ₀ (kg/m³).
+    pub density: Spanned<f64>,
+    /// Yield stress ρ_y (Pa), for `von_mises`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yield_stress: Option<f64>,
+    /// Linear hardening modulus (Pa), for `von_mises`.
+    #[serde(default)]
+    pub hardening: f64,
+}
+
+/// A region of space: a box, a polygon (2D), a sphere or disc, or a union
+/// or difference of regions.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum RegionSpec {
+    /// The box `lower ..= upper`.
+    Box {
+        /// Lower corner.
+        lower: Spanned<Vec<f64>>,
+        /// Upper corner.
+        upper: Spanned<Vec<f64>>,
+    },
+    /// A simple polygon (2D), vertices in order.
+    Polygon(Spanned<Vec<[f64; 2]>>),
+    /// A disc (2D) or ball (3D).
+    Sphere {
+        /// Centre.
+        centre: Spanned<Vec<f64>>,
+        /// Radius (m).
+        radius: Spanned<f64>,
+    },
+    /// Points in any of the regions.
+    Union(Vec<RegionSpec>),
+    /// Points in the first region and in none of the others.
+    Difference(Spanned<Vec<RegionSpec>>),
+}
+
+/// `[[body]]`: material points filling a region.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Name (for messages and outputs).
+    pub name: Spanned<String>,
+    /// Name of its `[[material]]`.
+    pub material: Spanned<String>,
+    /// Where its points are.
+    pub region: RegionSpec,
+    /// Points per cell per axis (on a regular lattice: each point at the
+    /// centre of its sub-cell, kept when the centre is in the region).
+    #[serde(default = "default_points_per_cell")]
+    pub points_per_cell: Spanned<usize>,
+}
+
+fn default_points_per_cell() -> Spanned<usize> {
+    Spanned::new(0..0, 2)
+}
+
+/// `[[node_set]]`: the grid nodes in a region, by name.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct NodeSetSpec {
+    /// Name the boundaries and outputs use.
+    pub name: Spanned<String>,
+    /// The nodes inside it (boundary included) form the set.
+    pub region: RegionSpec,
+}
+
+/// Kinds of Dirichlet condition.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BoundaryKind {
+    /// Every component fixed.
+    Fixed,
+    /// The normal component of a grid face fixed.
+    Roller,
+    /// Components given in `displacement` prescribed, following `curve`.
+    Displacement,
+    /// Prescribed velocity (explicit solver; refused by the implicit one).
+    Velocity,
+}
+
+/// Per-axis values; axes not given are left alone.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Axes {
+    /// x component.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub x: Option<f64>,
+    /// y component.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y: Option<f64>,
+    /// z component.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub z: Option<f64>,
+}
+
+impl Axes {
+    /// The components, `x, y, z`.
+    pub fn get(&self) -> [Option<f64>; 3] {
+        [self.x, self.y, self.z]
+    }
+}
+
+/// `[[boundary]]`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BoundarySpec {
+    /// Node set: a grid face (`x_min`, `x_max`, `y_min`, `y_max`, `z_min`,
+    /// `z_max`) or a `[[node_set]]` name.
+    pub set: Spanned<String>,
+    /// What is prescribed.
+    pub kind: Spanned<BoundaryKind>,
+    /// For `displacement`: the displacement reached where the curve is 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub displacement: Option<Spanned<Axes>>,
+    /// For `displacement`: the load curve (default: linear in the load
+    /// factor).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curve: Option<Spanned<String>>,
+}
+
+/// Kinds of load.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LoadKind {
+    /// A body force per unit mass on every body (or on `body`).
+    Gravity,
+    /// A force on the point nearest `at`, or shared by the points in
+    /// `region`.
+    Point,
+    /// A traction on one side of a body, shared by its points on that side
+    /// by their face areas.
+    Traction,
+}
+
+/// `[[load]]`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// What kind of load.
+    pub kind: Spanned<LoadKind>,
+    /// `gravity`: the acceleration (m/s²).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub acceleration: Option<Spanned<Vec<f64>>>,
+    /// `point`: the total force (N; per unit thickness in 2D).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force: Option<Spanned<Vec<f64>>>,
+    /// `point`: the location whose nearest point takes the force.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub at: Option<Spanned<Vec<f64>>>,
+    /// `point`: the region whose points share the force equally.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<RegionSpec>,
+    /// `traction`: the traction (Pa).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub traction: Option<Spanned<Vec<f64>>>,
+    /// `traction`: the side of the body (`x_min` … `z_max`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub side: Option<Spanned<String>>,
+    /// `gravity` (optional) and `traction` (required): the body loaded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<Spanned<String>>,
+    /// The load curve (default: linear in the load factor).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curve: Option<Spanned<String>>,
+}
+
+/// `[[curve]]`: a piecewise-linear factor over the load factor, from a
+/// table of `[time, factor]` rows with increasing times; constant beyond
+/// the first and last row.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CurveSpec {
+    /// Name the loads and boundaries use.
+    pub name: Spanned<String>,
+    /// `[time, factor]` rows; time is the load factor, 0 to 1.
+    pub points: Spanned<Vec<[f64; 2]>>,
+}
+
+/// Kinds of solver.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolverKind {
+    /// Quasi-static implicit Newton–Raphson.
+    #[default]
+    Implicit,
+}
+
+/// `[solver]`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverSpec {
+    /// The solver.
+    pub kind: SolverKind,
+    /// Basis functions.
+    pub basis: BasisKind,
+    /// Statement of equilibrium.
+    pub formulation: FormulationKind,
+    /// Locking treatment.
+    pub locking: LockingKind,
+    /// GIMP domain update.
+    pub domain_update: DomainUpdateKind,
+    /// Integration volume of GIMP points.
+    pub gimp_volume: GimpVolumeKind,
+    /// Number of equal load steps (the first increment is 1/steps).
+    pub steps: Spanned<usize>,
+    /// Largest load increment with automatic stepping (default 1/steps:
+    /// uniform steps, halved after a failure).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_increment: Option<Spanned<f64>>,
+    /// Smallest load increment before the run stops (default
+    /// 1/(1024 steps)).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_increment: Option<Spanned<f64>>,
+    /// Newton tolerance on the normalised residual (eq. 40).
+    pub tolerance: Spanned<f64>,
+    /// Newton iteration limit per step.
+    pub max_iterations: Spanned<usize>,
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        let v = crate::variant::Variant::default();
+        let newton = mpm_solver::NewtonOptions::default();
+        Self {
+            kind: SolverKind::Implicit,
+            basis: v.basis,
+            formulation: v.formulation,
+            locking: v.locking,
+            domain_update: v.domain_update,
+            gimp_volume: v.gimp_volume,
+            steps: Spanned::new(0..0, 10),
+            max_increment: None,
+            min_increment: None,
+            tolerance: Spanned::new(0..0, 1e-9),
+            max_iterations: Spanned::new(0..0, newton.max_iterations),
+        }
+    }
+}
+
+pub use crate::writer::Field;
+
+/// A reaction history: the sum of the reactions on a node set.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ReactionSpec {
+    /// File name stem: `reaction_<name>.csv`.
+    pub name: Spanned<String>,
+    /// The node set.
+    pub set: Spanned<String>,
+}
+
+/// A displacement history of the material point nearest a location.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSpec {
+    /// File name stem: `probe_<name>.csv`.
+    pub name: Spanned<String>,
+    /// The location (in the initial configuration).
+    pub at: Spanned<Vec<f64>>,
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct OutputSpec {
+    /// Write the VTU files every this many steps (and always the last).
+    pub every: Spanned<usize>,
+    /// Fields of the material-point VTU files (default: all).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fields: Option<Vec<Field>>,
+    /// Reaction histories.
+    #[serde(rename = "reaction", skip_serializing_if = "Vec::is_empty")]
+    pub reactions: Vec<ReactionSpec>,
+    /// Displacement histories.
+    #[serde(rename = "probe", skip_serializing_if = "Vec::is_empty")]
+    pub probes: Vec<ProbeSpec>,
+    /// Also write a PNG of the final state (2D scenes).
+    pub png: bool,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        Self {
+            every: Spanned::new(0..0, 1),
+            fields: None,
+            reactions: Vec::new(),
+            probes: Vec::new(),
+            png: false,
+        }
+    }
+}

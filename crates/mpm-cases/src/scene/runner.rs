@@ -1,0 +1,148 @@
+//! Runs a built [`Problem`] with the variant and materials it names: the
+//! variant and the law are dispatched to a fully monomorphised solver (a
+//! scene of one material runs its law directly; several run a
+//! `MaterialSet` whose history carries each point's material).
+
+use std::sync::Arc;
+
+use mpm_constitutive::LogStrainLaw;
+use mpm_mesh::RegularGrid;
+use mpm_solver::{
+    BodyForcePath, DomainUpdater, Flat, Formulation, MaterialPoints, SolverError, StepReport,
+};
+use nalgebra::SVector;
+
+use crate::body::InitialDomain;
+use crate::material::{LawVisitor, MaterialTag, dispatch_law, dispatch_law_set};
+use crate::run::{
+    Analysis, DomainBounds, HistoryOutput, RunControl, RunOutput, Snapshot, simulate_points,
+};
+use crate::variant::{VariantVisitor, dispatch};
+
+use super::build::Problem;
+
+/// Runs `problem`; `observer` sees every converged step.
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] for a variant that does not exist (e.g.
+/// a domain update with a basis without domains), and whatever the run
+/// returns.
+pub fn run<const D: usize, O>(
+    problem: &Problem<D>,
+    control: &RunControl,
+    observer: O,
+) -> Result<RunOutput<D>, SolverError>
+where
+    O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
+{
+    dispatch(
+        &problem.variant,
+        WithVariant {
+            problem,
+            control,
+            observer,
+        },
+    )
+    .map_err(SolverError::InvalidInput)?
+}
+
+struct WithVariant<'a, const D: usize, O> {
+    problem: &'a Problem<D>,
+    control: &'a RunControl,
+    observer: O,
+}
+
+impl<const D: usize, O> VariantVisitor<D> for WithVariant<'_, D, O>
+where
+    O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
+{
+    type Output = Result<RunOutput<D>, SolverError>;
+
+    fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
+    where
+        B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>,
+        F: Formulation,
+        U: DomainUpdater<D, B::Domain>,
+    {
+        let materials = &self.problem.materials;
+        let model = materials[0].model;
+        let with_law = WithLaw::<D, B, F, U, O> {
+            run: self,
+            basis,
+            updater,
+            formulation: std::marker::PhantomData,
+        };
+        if materials.len() == 1 {
+            dispatch_law(model, &materials[0].params, with_law)?
+        } else {
+            let params: Vec<_> = materials.iter().map(|m| m.params).collect();
+            dispatch_law_set(model, &params, with_law)?
+        }
+    }
+}
+
+struct WithLaw<'a, const D: usize, B, F, U, O> {
+    run: WithVariant<'a, D, O>,
+    basis: B,
+    updater: U,
+    formulation: std::marker::PhantomData<F>,
+}
+
+impl<const D: usize, B, F, U, O> LawVisitor for WithLaw<'_, D, B, F, U, O>
+where
+    B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>,
+    F: Formulation,
+    U: DomainUpdater<D, B::Domain>,
+    O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
+{
+    type Output = Result<RunOutput<D>, SolverError>;
+
+    fn visit<L>(self, law: L) -> Self::Output
+    where
+        L: LogStrainLaw,
+        L::History: HistoryOutput + Flat + MaterialTag,
+    {
+        let p = self.run.problem;
+        let domains = p
+            .position
+            .iter()
+            .zip(&p.half_lengths)
+            .map(|(x, l)| B::initial_domain(x, l))
+            .collect();
+        let mut points: MaterialPoints<D, L::History, B::Domain> =
+            MaterialPoints::new(p.position.clone(), p.volume.clone(), 0.0, domains)?;
+        points.mass.clone_from(&p.mass);
+        if p.materials.len() > 1 {
+            points.history = p
+                .material_of_point
+                .iter()
+                .map(|&m| L::History::for_material(m))
+                .collect();
+        }
+        points.body_force.clone_from(&p.body_force);
+        points.point_force.clone_from(&p.point_forces);
+        if !p.curved.is_empty() {
+            let curved = Arc::new(p.curved.clone());
+            points.body_force_path = Some(BodyForcePath(Arc::new(move |point, lambda| {
+                curved
+                    .iter()
+                    .fold(SVector::<f64, D>::zeros(), |f, c| f + c.force[point] * c.curve.at(lambda))
+            })));
+        }
+        let analysis = Analysis {
+            grid: p.grid.clone(),
+            law,
+            constraints: p.constraints.clone(),
+            stepping: p.stepping,
+            newton: p.newton,
+        };
+        simulate_points::<D, B, F, U, L, _, _>(
+            points,
+            analysis,
+            self.basis,
+            self.updater,
+            self.run.control,
+            self.run.observer,
+        )
+    }
+}
