@@ -574,7 +574,11 @@ fn scene_run_in<const D: usize>(
         constants: vec![
             (
                 "body".into(),
-                problem.body_of_point.iter().map(|&b| f64::from(b)).collect(),
+                problem
+                    .body_of_point
+                    .iter()
+                    .map(|&b| f64::from(b))
+                    .collect(),
             ),
             (
                 "material".into(),
@@ -628,11 +632,13 @@ fn scene_run_in<const D: usize>(
     results.insert("probes".into(), Value::Object(last_probes));
     results.insert(
         "bodies".into(),
-        json!(problem
-            .bodies
-            .iter()
-            .map(|b| json!({"name": b.name, "material_points": b.points.len()}))
-            .collect::<Vec<_>>()),
+        json!(
+            problem
+                .bodies
+                .iter()
+                .map(|b| json!({"name": b.name, "material_points": b.points.len()}))
+                .collect::<Vec<_>>()
+        ),
     );
     if problem.png {
         let last = &r.last;
@@ -656,7 +662,8 @@ fn scene_run_in<const D: usize>(
             .map(|((l, v), v0)| l[0] * (v / v0).sqrt())
             .collect();
         let path = obs.writer.dir().join("final.png");
-        let (lo, hi) = mpm_cases::scene::png::write_points_png(&path, &last.position, &half, &value)?;
+        let (lo, hi) =
+            mpm_cases::scene::png::write_points_png(&path, &last.position, &half, &value)?;
         results.insert(
             "png".into(),
             json!({"file": "final.png", "colour": name, "blue": lo, "red": hi}),

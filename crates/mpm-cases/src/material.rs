@@ -4,7 +4,9 @@
 //! A new law is one file in `mpm-constitutive` (an implementation of
 //! `LogStrainLaw`) and one line in the [`register_laws!`] call below.
 
-use mpm_constitutive::{HenckyElastic, LogStrainLaw, MaterialSet, Tagged, VonMises, VonMisesHistory};
+use mpm_constitutive::{
+    HenckyElastic, LogStrainLaw, MaterialSet, Tagged, VonMises, VonMisesHistory,
+};
 use mpm_solver::{Flat, SolverError};
 
 use crate::run::HistoryOutput;

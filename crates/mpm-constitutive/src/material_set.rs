@@ -154,7 +154,10 @@ mod tests {
         }
         // The three differ: yielding in the first and third only.
         let yielded: Vec<bool> = (0..3)
-            .map(|k| set.return_map(&trial, &Tagged::new(k, Default::default())).yielded)
+            .map(|k| {
+                set.return_map(&trial, &Tagged::new(k, Default::default()))
+                    .yielded
+            })
             .collect();
         assert_eq!(yielded, [true, false, true]);
         assert!(set.contains(&Tagged::new(2, ())));

@@ -206,7 +206,9 @@ impl Check<'_> {
         if x >= min {
             Ok(x)
         } else {
-            Err(self.src.at(v, format!("{what} must be at least {min}, got {x}")))
+            Err(self
+                .src
+                .at(v, format!("{what} must be at least {min}, got {x}")))
         }
     }
 }
@@ -277,7 +279,11 @@ impl<const D: usize> Problem<D> {
     /// [`CasesError::Scene`] (or [`CasesError::Override`]) at the value
     /// that is wrong, [`CasesError::SceneUnlocated`] for what has no single
     /// place.
-    pub fn build(scene: &Scene, src: &SceneSource, basis_padding: usize) -> Result<Self, CasesError> {
+    pub fn build(
+        scene: &Scene,
+        src: &SceneSource,
+        basis_padding: usize,
+    ) -> Result<Self, CasesError> {
         let check = Check { src };
         let variant = Variant {
             basis: scene.solver.basis,
@@ -294,7 +300,10 @@ impl<const D: usize> Problem<D> {
         if let Some(axis) = (0..D).find(|&i| size[i] <= 0.0) {
             return Err(src.at(
                 &m.size,
-                format!("mesh `size` must be positive on every axis ({} is {})", AXES[axis], size[axis]),
+                format!(
+                    "mesh `size` must be positive on every axis ({} is {})",
+                    AXES[axis], size[axis]
+                ),
             ));
         }
         let cells: [usize; D] = match (&m.cells, &m.spacing) {
@@ -302,7 +311,10 @@ impl<const D: usize> Problem<D> {
                 if c.get_ref().len() != D {
                     return Err(src.at(
                         c,
-                        format!("mesh `cells` has {} entries; the scene is {D}D", c.get_ref().len()),
+                        format!(
+                            "mesh `cells` has {} entries; the scene is {D}D",
+                            c.get_ref().len()
+                        ),
                     ));
                 }
                 if c.get_ref().contains(&0) {
@@ -315,7 +327,11 @@ impl<const D: usize> Problem<D> {
                 let mut cells = [0usize; D];
                 for i in 0..D {
                     let n = size[i] / h_v[i];
-                    if !(h_v[i] > 0.0 && n.is_finite() && n >= 0.5 && (n - n.round()).abs() <= 1e-9 * n.max(1.0)) {
+                    if !(h_v[i] > 0.0
+                        && n.is_finite()
+                        && n >= 0.5
+                        && (n - n.round()).abs() <= 1e-9 * n.max(1.0))
+                    {
                         return Err(src.at(
                             h,
                             format!(
@@ -360,12 +376,8 @@ impl<const D: usize> Problem<D> {
                 format!("the grid would have more than {MAX_ENTITIES} nodes"),
             ));
         }
-        let grid = RegularGrid::new(
-            origin - spacing * padding as f64,
-            spacing,
-            padded,
-        )
-        .map_err(|e| src.at(&m.origin, format!("mesh: {e}")))?;
+        let grid = RegularGrid::new(origin - spacing * padding as f64, spacing, padded)
+            .map_err(|e| src.at(&m.origin, format!("mesh: {e}")))?;
         let upper = origin + size;
         let tol = 1e-9 * size.max();
 
@@ -402,7 +414,8 @@ impl<const D: usize> Problem<D> {
         };
 
         // Materials.
-        let material_names = unique_names(scene.materials.iter().map(|m| &m.name), "material", src)?;
+        let material_names =
+            unique_names(scene.materials.iter().map(|m| &m.name), "material", src)?;
         if scene.materials.is_empty() {
             return Err(src.error(None, "a scene needs at least one [[material]]"));
         }
@@ -425,11 +438,18 @@ impl<const D: usize> Problem<D> {
             if spec.model != MaterialModel::VonMises && spec.yield_stress.is_some() {
                 return Err(src.at(
                     &spec.name,
-                    format!("material `{}`: yield_stress applies to model = von_mises", spec.name.get_ref()),
+                    format!(
+                        "material `{}`: yield_stress applies to model = von_mises",
+                        spec.name.get_ref()
+                    ),
                 ));
             }
-            dispatch_law(spec.model, &params, Validate)
-                .map_err(|e| src.at(&spec.name, format!("material `{}`: {e}", spec.name.get_ref())))?;
+            dispatch_law(spec.model, &params, Validate).map_err(|e| {
+                src.at(
+                    &spec.name,
+                    format!("material `{}`: {e}", spec.name.get_ref()),
+                )
+            })?;
             let model = if plastic && spec.model == MaterialModel::Hencky {
                 params.yield_stress = Some(f64::MAX);
                 params.hardening = 0.0;
@@ -472,7 +492,15 @@ impl<const D: usize> Problem<D> {
             }
             let ppc = check.at_least(&spec.points_per_cell, 1, "points_per_cell")?;
             let start = problem_points.position.len();
-            let step = problem_points.fill(&grid, padding, cells, &region, ppc, src, &spec.points_per_cell)?;
+            let step = problem_points.fill(
+                &grid,
+                padding,
+                cells,
+                &region,
+                ppc,
+                src,
+                &spec.points_per_cell,
+            )?;
             let end = problem_points.position.len();
             if end == start {
                 return Err(src.at(
@@ -525,11 +553,19 @@ impl<const D: usize> Problem<D> {
         let node_position = |v: usize| grid.node_position(v).unwrap_or_else(|_| SVector::zeros());
         for axis in 0..D {
             for upper_face in [false, true] {
-                let bound = if upper_face { upper[axis] } else { origin[axis] };
+                let bound = if upper_face {
+                    upper[axis]
+                } else {
+                    origin[axis]
+                };
                 let nodes = (0..grid.node_count())
                     .filter(|&v| {
                         let x = node_position(v)[axis];
-                        if upper_face { x >= bound - tol } else { x <= bound + tol }
+                        if upper_face {
+                            x >= bound - tol
+                        } else {
+                            x <= bound + tol
+                        }
                     })
                     .collect();
                 sets.insert(face_name(axis, upper_face), nodes);
@@ -540,7 +576,10 @@ impl<const D: usize> Problem<D> {
             if sets.contains_key(spec.name.get_ref()) {
                 return Err(src.at(
                     &spec.name,
-                    format!("node set `{}` is already defined (a grid face or an earlier set)", spec.name.get_ref()),
+                    format!(
+                        "node set `{}` is already defined (a grid face or an earlier set)",
+                        spec.name.get_ref()
+                    ),
                 ));
             }
             let region = Region::<D>::new(&spec.region, src)?;
@@ -578,11 +617,18 @@ impl<const D: usize> Problem<D> {
                 }
             };
             let not_here = |what: &str, kind: &str| {
-                src.at(&spec.kind, format!("`{what}` applies to kind = displacement, not {kind}"))
+                src.at(
+                    &spec.kind,
+                    format!("`{what}` applies to kind = displacement, not {kind}"),
+                )
             };
             match spec.kind.get_ref() {
                 BoundaryKind::Fixed | BoundaryKind::Roller => {
-                    let kind = if *spec.kind.get_ref() == BoundaryKind::Fixed { "fixed" } else { "roller" };
+                    let kind = if *spec.kind.get_ref() == BoundaryKind::Fixed {
+                        "fixed"
+                    } else {
+                        "roller"
+                    };
                     if spec.displacement.is_some() {
                         return Err(not_here("displacement", kind));
                     }
@@ -610,12 +656,17 @@ impl<const D: usize> Problem<D> {
                 }
                 BoundaryKind::Displacement => {
                     let Some(d) = &spec.displacement else {
-                        return Err(src.at(&spec.kind, "kind = displacement needs `displacement = { x = …, y = … }`"));
+                        return Err(src.at(
+                            &spec.kind,
+                            "kind = displacement needs `displacement = { x = …, y = … }`",
+                        ));
                     };
                     let curve = curve_of(&spec.curve)?;
                     let values = d.get_ref().get();
                     if let Some(axis) = (D..3).find(|&i| values[i].is_some()) {
-                        return Err(src.at(d, format!("a {D}D scene has no {} component", AXES[axis])));
+                        return Err(
+                            src.at(d, format!("a {D}D scene has no {} component", AXES[axis]))
+                        );
                     }
                     if values.iter().all(Option::is_none) {
                         return Err(src.at(d, "`displacement` needs at least one of x, y, z"));
@@ -658,11 +709,18 @@ impl<const D: usize> Problem<D> {
             let kind = *spec.kind.get_ref();
             let curve = curve_of(&spec.curve)?;
             let refuse = |key: &str, applies: &str| {
-                src.at(&spec.kind, format!("`{key}` applies to kind = {applies} loads"))
+                src.at(
+                    &spec.kind,
+                    format!("`{key}` applies to kind = {applies} loads"),
+                )
             };
             // Keys that belong to other kinds.
             let present: [(&str, bool, LoadKind); 6] = [
-                ("acceleration", spec.acceleration.is_some(), LoadKind::Gravity),
+                (
+                    "acceleration",
+                    spec.acceleration.is_some(),
+                    LoadKind::Gravity,
+                ),
                 ("force", spec.force.is_some(), LoadKind::Point),
                 ("at", spec.at.is_some(), LoadKind::Point),
                 ("region", spec.region.is_some(), LoadKind::Point),
@@ -719,7 +777,10 @@ impl<const D: usize> Problem<D> {
                                 .filter(|&p| region.contains(&problem_points.position[p]))
                                 .collect();
                             if inside.is_empty() {
-                                return Err(src.at(&spec.kind, "the point load's region holds no material point"));
+                                return Err(src.at(
+                                    &spec.kind,
+                                    "the point load's region holds no material point",
+                                ));
                             }
                             let share = f / inside.len() as f64;
                             for p in inside {
@@ -727,13 +788,19 @@ impl<const D: usize> Problem<D> {
                             }
                         }
                         _ => {
-                            return Err(src.at(&spec.kind, "a point load needs one of `at` or `region`"));
+                            return Err(
+                                src.at(&spec.kind, "a point load needs one of `at` or `region`")
+                            );
                         }
                     }
                 }
                 LoadKind::Traction => {
-                    let (Some(t), Some(side), Some(b)) = (&spec.traction, &spec.side, &spec.body) else {
-                        return Err(src.at(&spec.kind, "a traction load needs `traction`, `side` and `body`"));
+                    let (Some(t), Some(side), Some(b)) = (&spec.traction, &spec.side, &spec.body)
+                    else {
+                        return Err(src.at(
+                            &spec.kind,
+                            "a traction load needs `traction`, `side` and `body`",
+                        ));
                     };
                     let t = point::<D>(t, "`traction`", src)?;
                     let k = lookup(&body_names, b, "body", src)?;
@@ -741,14 +808,17 @@ impl<const D: usize> Problem<D> {
                         .flat_map(|i| [(i, false), (i, true)])
                         .find(|&(i, up)| face_name(i, up) == *side.get_ref());
                     let Some((axis, up)) = face else {
-                        return Err(src.at(
-                            side,
-                            format!("`side` must be one of {}", faces.join(", ")),
-                        ));
+                        return Err(
+                            src.at(side, format!("`side` must be one of {}", faces.join(", ")))
+                        );
                     };
                     let body = &bodies[k];
                     let mut offset = SVector::<f64, D>::zeros();
-                    offset[axis] = if up { body.step[axis] } else { -body.step[axis] };
+                    offset[axis] = if up {
+                        body.step[axis]
+                    } else {
+                        -body.step[axis]
+                    };
                     let mut loaded = 0;
                     for p in body.points.clone() {
                         let x = problem_points.position[p];
@@ -760,7 +830,14 @@ impl<const D: usize> Problem<D> {
                         }
                     }
                     if loaded == 0 {
-                        return Err(src.at(side, format!("body `{}` has no points on side {}", body.name, side.get_ref())));
+                        return Err(src.at(
+                            side,
+                            format!(
+                                "body `{}` has no points on side {}",
+                                body.name,
+                                side.get_ref()
+                            ),
+                        ));
                     }
                 }
             }
@@ -779,10 +856,15 @@ impl<const D: usize> Problem<D> {
                 } else if body_force.is_empty() {
                     body_force = forces;
                 } else {
-                    body_force.iter_mut().zip(&forces).for_each(|(a, b)| *a += b);
+                    body_force
+                        .iter_mut()
+                        .zip(&forces)
+                        .for_each(|(a, b)| *a += b);
                 }
             } else {
-                let entry = curved.entry(curve).or_insert_with(|| vec![SVector::zeros(); n]);
+                let entry = curved
+                    .entry(curve)
+                    .or_insert_with(|| vec![SVector::zeros(); n]);
                 entry.iter_mut().zip(&forces).for_each(|(a, b)| *a += b);
             }
         }
@@ -821,8 +903,15 @@ impl<const D: usize> Problem<D> {
         let every = check.at_least(&o.every, 1, "output `every`")?;
         let safe = |name: &Spanned<String>| -> Result<String, CasesError> {
             let v = name.get_ref();
-            if v.is_empty() || !v.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
-                return Err(src.at(name, "an output name must be letters, digits, `_` or `-` (it names a file)"));
+            if v.is_empty()
+                || !v
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+            {
+                return Err(src.at(
+                    name,
+                    "an output name must be letters, digits, `_` or `-` (it names a file)",
+                ));
             }
             Ok(v.clone())
         };
@@ -836,7 +925,12 @@ impl<const D: usize> Problem<D> {
         let probes = o
             .probes
             .iter()
-            .map(|p| Ok((safe(&p.name)?, nearest(&point::<D>(&p.at, "probe `at`", src)?))))
+            .map(|p| {
+                Ok((
+                    safe(&p.name)?,
+                    nearest(&point::<D>(&p.at, "probe `at`", src)?),
+                ))
+            })
             .collect::<Result<Vec<_>, CasesError>>()?;
         if o.png && D != 2 {
             return Err(src.error(None, "output `png` draws 2D scenes only"));

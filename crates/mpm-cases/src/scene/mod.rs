@@ -73,7 +73,11 @@ use crate::scene_file::{SceneSource, parse_scene_located};
 ///
 /// # Errors
 /// As [`crate::scene_file::parse_scene`].
-pub fn parse(text: &str, origin: &str, overrides: &[String]) -> Result<(Scene, SceneSource), CasesError> {
+pub fn parse(
+    text: &str,
+    origin: &str,
+    overrides: &[String],
+) -> Result<(Scene, SceneSource), CasesError> {
     parse_scene_located(text, origin, overrides)
 }
 

@@ -45,7 +45,9 @@ pub fn write_points_png(
     }
     let (vmin, vmax) = value
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
     let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
     if position.is_empty() || !(extent.is_finite() && extent > 0.0) {
         return Err(CasesError::LengthMismatch {
@@ -62,10 +64,20 @@ pub fn write_points_png(
     let range = vmax - vmin;
     for ((x, h), v) in position.iter().zip(half).zip(value) {
         let t = if range > 0.0 { (v - vmin) / range } else { 0.5 };
-        let colour = [(255.0 * t) as u8, (80.0 * (1.0 - (2.0 * t - 1.0).abs())) as u8, (255.0 * (1.0 - t)) as u8];
+        let colour = [
+            (255.0 * t) as u8,
+            (80.0 * (1.0 - (2.0 * t - 1.0).abs())) as u8,
+            (255.0 * (1.0 - t)) as u8,
+        ];
         let px = |c: f64, axis: usize| (c - lo[axis] + margin) * scale;
-        let (x0, x1) = (px(x[0] - h, 0).floor() as i64, px(x[0] + h, 0).ceil() as i64);
-        let (y0, y1) = (px(x[1] - h, 1).floor() as i64, px(x[1] + h, 1).ceil() as i64);
+        let (x0, x1) = (
+            px(x[0] - h, 0).floor() as i64,
+            px(x[0] + h, 0).ceil() as i64,
+        );
+        let (y0, y1) = (
+            px(x[1] - h, 1).floor() as i64,
+            px(x[1] + h, 1).ceil() as i64,
+        );
         for j in y0.max(0)..y1.min(i64::from(height)) {
             // Image rows run downwards.
             let row = i64::from(height) - 1 - j;

@@ -90,7 +90,8 @@ impl<const D: usize> Region<D> {
                     return Err(src.at(vertices, "a polygon region needs a 2D scene"));
                 }
                 let v = vertices.get_ref();
-                if v.len() < 3 || polygon_area(v).abs() <= f64::EPSILON * bounding_scale(v).powi(2) {
+                if v.len() < 3 || polygon_area(v).abs() <= f64::EPSILON * bounding_scale(v).powi(2)
+                {
                     return Err(src.at(
                         vertices,
                         "a polygon needs at least three vertices enclosing a non-zero area",

@@ -124,9 +124,9 @@ where
         if !p.curved.is_empty() {
             let curved = Arc::new(p.curved.clone());
             points.body_force_path = Some(BodyForcePath(Arc::new(move |point, lambda| {
-                curved
-                    .iter()
-                    .fold(SVector::<f64, D>::zeros(), |f, c| f + c.force[point] * c.curve.at(lambda))
+                curved.iter().fold(SVector::<f64, D>::zeros(), |f, c| {
+                    f + c.force[point] * c.curve.at(lambda)
+                })
             })));
         }
         let analysis = Analysis {

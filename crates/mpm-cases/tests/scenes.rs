@@ -1,0 +1,506 @@
+//! Scenes as data: the two example scenes against their references, the
+//! validation of malformed scenes (each error with its place), and random
+//! mutations of a valid scene, which must never panic.
+#![allow(clippy::unwrap_used)]
+
+mod common;
+
+use mpm_cases::CasesError;
+use mpm_cases::run::{RunControl, RunOutput};
+use mpm_cases::scene::{self, Problem};
+use proptest::prelude::*;
+
+const TWO_LAYER: &str = include_str!("../../../scenes/two_layer_column.toml");
+const SLOPE: &str = include_str!("../../../scenes/slope.toml");
+
+/// Parses, builds and runs a 2D scene.
+fn run2(text: &str, overrides: &[&str]) -> (Problem<2>, RunOutput<2>) {
+    let set: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let (scene, src) = scene::parse(text, "scene.toml", &set).unwrap();
+    let problem = Problem::<2>::build(&scene, &src, scene.solver.basis.padding()).unwrap();
+    let out = scene::run(&problem, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+    (problem, out)
+}
+
+/// The error of a scene that must not build, as text.
+fn refusal(text: &str) -> String {
+    let built =
+        scene::parse(text, "bad.toml", &[]).and_then(|(scene, src)| {
+            match scene::dimension(&scene, &src)? {
+                2 => Problem::<2>::build(&scene, &src, scene.solver.basis.padding()).map(|_| ()),
+                _ => Problem::<3>::build(&scene, &src, scene.solver.basis.padding()).map(|_| ()),
+            }
+        });
+    match built {
+        Ok(()) => panic!("the scene was accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// The two-layer column's closed form (ν = 0, Hencky, uniaxial strain):
+/// σ = E ln λ / λ = −ϱ g (H − Y) gives the stretch λ(Y) = exp(−W(−s)),
+/// s = σ/E (W the principal Lambert function, here by Newton on
+/// ln λ = s λ), and u(Y) = ∫₀^Y (λ − 1) dY' layer by layer (Simpson's
+/// rule with 2000 panels per layer: the integrand is smooth within each).
+struct TwoLayer {
+    rho_g: f64,
+    height: f64,
+    interface: f64,
+    e_lower: f64,
+    e_upper: f64,
+}
+
+impl TwoLayer {
+    const SCENE: TwoLayer = TwoLayer {
+        rho_g: 800.0,
+        height: 10.0,
+        interface: 5.0,
+        e_lower: 1e7,
+        e_upper: 1e5,
+    };
+
+    fn sigma(&self, y: f64) -> f64 {
+        -self.rho_g * (self.height - y)
+    }
+
+    fn stretch(&self, y: f64, e: f64) -> f64 {
+        let s = self.sigma(y) / e;
+        let mut l = 1.0f64;
+        for _ in 0..50 {
+            l -= (l.ln() - s * l) / (1.0 / l - s);
+        }
+        l
+    }
+
+    fn displacement(&self, y: f64) -> f64 {
+        let simpson = |a: f64, b: f64, e: f64| {
+            if b <= a {
+                return 0.0;
+            }
+            let n = 2000;
+            let h = (b - a) / n as f64;
+            (0..=n)
+                .map(|k| {
+                    let w = if k == 0 || k == n {
+                        1.0
+                    } else if k % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    };
+                    w * (self.stretch(a + k as f64 * h, e) - 1.0)
+                })
+                .sum::<f64>()
+                * h
+                / 3.0
+        };
+        simpson(0.0, y.min(self.interface), self.e_lower) + simpson(self.interface, y, self.e_upper)
+    }
+}
+
+#[test]
+fn two_layer_column_matches_its_closed_form_and_converges() {
+    let reference = TwoLayer::SCENE;
+    let mut previous = (f64::INFINITY, f64::INFINITY);
+    let mut rows = Vec::new();
+    for cells in [8, 16, 32, 64] {
+        let cells_override = format!("mesh.cells=[1, {cells}]");
+        let (problem, out) = run2(TWO_LAYER, &[&cells_override]);
+        let last = &out.last;
+        let mut errors = Vec::new();
+        for (name, p) in &problem.probes {
+            let y0 = problem.position[*p][1];
+            let exact = reference.displacement(y0);
+            let got = last.displacement[*p][1];
+            errors.push((name.clone(), ((got - exact) / exact).abs()));
+        }
+        let top = errors.iter().find(|e| e.0 == "top").unwrap().1;
+        let interface = errors.iter().find(|e| e.0 == "interface").unwrap().1;
+        // σ_yy = −ϱ g (H − Y) at every point (eq. 42's normalisation).
+        let stress_error: f64 = (0..problem.len())
+            .map(|p| {
+                (last.sigma[p][4] - reference.sigma(problem.position[p][1])).abs()
+                    * problem.volume[p]
+            })
+            .sum::<f64>()
+            / (reference.rho_g * reference.height * 10.0);
+        rows.push((cells, top, interface, stress_error));
+        assert!(
+            top < previous.0 && interface < previous.1,
+            "errors must fall with h: {rows:?}"
+        );
+        previous = (top, interface);
+        // The base carries the whole weight.
+        let weight = reference.rho_g * reference.height;
+        let reaction = out.reports.last().unwrap().reaction[1];
+        assert!((reaction - weight).abs() < 1e-9 * weight, "{reaction}");
+    }
+    let (_, top, interface, stress) = *rows.last().unwrap();
+    assert!(top < 0.01 && interface < 0.01, "{rows:?}");
+    assert!(stress < 0.01, "{rows:?}");
+    eprintln!("two-layer column (cells, top, interface, stress error): {rows:?}");
+}
+
+#[test]
+fn slope_runs_with_its_curves_and_writes_png_and_vtu() {
+    let (problem, out) = run2(SLOPE, &[]);
+    // Gravity ramps to 1 at load factor 0.8, then the surcharge follows:
+    // at the end the base carries the weight of every point plus the
+    // surcharge on the upward faces, all of it vertical load.
+    let weight: f64 = problem.mass.iter().sum::<f64>() * 9.81;
+    let slope = &problem.bodies[1];
+    assert_eq!(slope.name, "slope");
+    let surcharge = 2.0e4 * 20.0;
+    let reaction = out.reports.last().unwrap().reaction[1];
+    assert!(
+        (reaction - weight - surcharge).abs() < 1e-8 * reaction,
+        "{reaction} against {}",
+        weight + surcharge
+    );
+    // The soil yields; the foundation (Hencky, run as von Mises with an
+    // infinite yield stress) does not.
+    let found = &problem.bodies[0];
+    assert!(
+        found
+            .points
+            .clone()
+            .all(|p| out.last.plastic_strain[p] == 0.0)
+    );
+    assert!(
+        slope
+            .points
+            .clone()
+            .any(|p| out.last.plastic_strain[p] > 1e-4)
+    );
+
+    let dir = common::fresh_dir("slope_scene");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
+        .args([
+            "run",
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/slope.toml"),
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let png = std::fs::read(dir.join("final.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    for file in [
+        "points.pvd",
+        "reaction_base.csv",
+        "probe_crest.csv",
+        "summary.json",
+    ] {
+        assert!(dir.join(file).exists(), "{file}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["case"], "scene");
+    let base = summary["reactions"]["base"][1].as_f64().unwrap();
+    assert!((base - reaction).abs() < 1e-9 * reaction);
+}
+
+/// A minimal valid 2D scene, mutated by the table below.
+const VALID: &str = r#"[mesh]
+origin = [0.0, 0.0]
+size = [2.0, 2.0]
+cells = [2, 2]
+
+[[material]]
+name = "m"
+model = "hencky"
+youngs_modulus = 1e6
+poisson_ratio = 0.3
+density = 1.0
+
+[[body]]
+name = "b"
+material = "m"
+region = { box = { lower = [0.0, 0.0], upper = [2.0, 1.0] } }
+
+[[boundary]]
+set = "y_min"
+kind = "fixed"
+
+[[load]]
+kind = "gravity"
+acceleration = [0.0, -10.0]
+
+[solver]
+steps = 2
+"#;
+
+#[test]
+fn the_valid_scene_builds_and_runs() {
+    let (problem, out) = run2(VALID, &[]);
+    assert_eq!(problem.len(), 8);
+    assert_eq!(out.summary.steps, 2);
+}
+
+/// Each malformed scene gives its own message at its own place.
+#[test]
+fn malformed_scenes_are_refused_with_a_located_message() {
+    let cases: &[(&str, &str, &str)] = &[
+        // (replace this, with this, expect this in the message)
+        (
+            "cells = [2, 2]",
+            "cells = [2, 2]\nspacings = [1.0]",
+            "bad.toml:5:1: unknown field `spacings`",
+        ),
+        (
+            "youngs_modulus = 1e6",
+            "youngs_modulus = \"stiff\"",
+            "bad.toml:9:18: invalid type: string \"stiff\", expected f64",
+        ),
+        (
+            "upper = [2.0, 1.0]",
+            "upper = [3.0, 1.0]",
+            "bad.toml:14:8: body `b` reaches outside the mesh: its region spans [0.0, 0.0] to [3.0, 1.0]",
+        ),
+        (
+            "lower = [0.0, 0.0], upper = [2.0, 1.0]",
+            "lower = [0.0, 0.0], upper = [0.1, 0.1]",
+            "bad.toml:14:8: body `b` holds no material points",
+        ),
+        (
+            "material = \"m\"",
+            "material = \"steel\"",
+            "bad.toml:15:12: no material named `steel`; the scene has: m",
+        ),
+        (
+            "set = \"y_min\"",
+            "set = \"bottom\"",
+            "bad.toml:19:7: no node set named `bottom`",
+        ),
+        (
+            "model = \"hencky\"",
+            "model = \"neo_hooke\"",
+            "bad.toml:8:9: unknown variant `neo_hooke`, expected `hencky` or `von_mises`",
+        ),
+        (
+            "poisson_ratio = 0.3",
+            "poisson_ratio = 0.5",
+            "bad.toml:7:8: material `m`: ",
+        ),
+        (
+            "origin = [0.0, 0.0]",
+            "origin = [0.0, 0.0, 0.0]",
+            "bad.toml:3:8: mesh `size` has 2 components; the scene is 3D",
+        ),
+        (
+            "acceleration = [0.0, -10.0]",
+            "acceleration = [0.0, -10.0]\ncurve = \"ramp\"",
+            "bad.toml:25:9: no curve named `ramp`",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"roller\"\ndisplacement = { y = 1.0 }",
+            "bad.toml:20:8: `displacement` applies to kind = displacement, not roller",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"velocity\"",
+            "bad.toml:20:8: kind = velocity needs the explicit solver",
+        ),
+        (
+            "steps = 2",
+            "steps = 0",
+            "bad.toml:27:9: solver `steps` must be at least 1, got 0",
+        ),
+        (
+            "[solver]",
+            "[[curve]]\nname = \"c\"\npoints = [[0.0, 0.0], [0.5, 1.0], [0.4, 2.0]]\n[solver]",
+            "bad.toml:28:10: curve `c`: times must increase, but row 3 has time 0.4 after 0.5",
+        ),
+        (
+            "[[boundary]]",
+            "[[body]]\nname = \"b2\"\nmaterial = \"m\"\nregion = { box = { lower = [0.0, 0.5], upper = [2.0, 2.0] } }\n\n[[boundary]]",
+            "bad.toml:19:8: body `b2` overlaps body `b` (both hold [0.25, 0.75])",
+        ),
+        (
+            "[[boundary]]",
+            "[[body]]\nname = \"b\"\nmaterial = \"m\"\nregion = { box = { lower = [0.0, 1.0], upper = [2.0, 2.0] } }\n\n[[boundary]]",
+            "bad.toml:19:8: a second body named `b`",
+        ),
+        (
+            "region = { box",
+            "region = { polygon = [[0.0, 0.0], [1.0, 0.0]] }\nregio = { box",
+            "bad.toml:17:1: unknown field `regio`",
+        ),
+        (
+            "kind = \"gravity\"",
+            "kind = \"gravity\"\nforce = [1.0, 0.0]",
+            "bad.toml:23:8: `force` applies to kind = point loads",
+        ),
+        (
+            "cells = [2, 2]",
+            "spacing = [0.75, 1.0]",
+            "bad.toml:4:11: mesh `spacing` 0.75 must be positive and divide the size 2 along x",
+        ),
+    ];
+    let mut wrong = Vec::new();
+    for (from, to, expected) in cases {
+        assert!(VALID.contains(from), "{from}");
+        let text = VALID.replacen(from, to, 1);
+        let message = refusal(&text);
+        if !message.contains(expected) {
+            wrong.push(format!(
+                "for `{to}`\nexpected: {expected}\n     got: {message}"
+            ));
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn missing_sections_and_bad_overrides_are_named() {
+    let start = VALID.find("[[body]]").unwrap();
+    let end = VALID.find("[[boundary]]").unwrap();
+    let no_body = format!("{}{}", &VALID[..start], &VALID[end..]);
+    assert_eq!(refusal(&no_body), "bad.toml: missing field `body`");
+    // Less padding than the basis needs.
+    let thin = VALID
+        .replacen("cells = [2, 2]", "cells = [2, 2]\npadding = 0", 1)
+        .replacen("steps = 2", "steps = 2\nbasis = \"bspline2\"", 1);
+    assert_eq!(
+        refusal(&thin),
+        "bad.toml:5:11: basis = bspline2 needs 1 padding cell(s), got 0"
+    );
+    let without_material = VALID.replacen("[[material]]", "[unused]", 1);
+    assert!(refusal(&without_material).contains("unknown field `unused`"));
+    let e = scene::parse(VALID, "v.toml", &["solver.stepz=3".into()]).unwrap_err();
+    assert!(
+        matches!(&e, CasesError::Override { text, message } if text == "solver.stepz=3" && message.contains("unknown field `stepz`")),
+        "{e}"
+    );
+}
+
+/// Random edits of a valid scene: deleting a line, truncating the file,
+/// swapping a value for one of another type. Whatever the result, parsing
+/// and building return (an error or a problem) and never panic.
+fn mutated() -> impl Strategy<Value = String> {
+    let lines: Vec<String> = VALID.lines().map(str::to_owned).collect();
+    let n = lines.len();
+    let values = prop_oneof![
+        Just("\"text\"".to_owned()),
+        Just("-1".to_owned()),
+        Just("0".to_owned()),
+        Just("1e300".to_owned()),
+        Just("[]".to_owned()),
+        Just("[1.0]".to_owned()),
+        Just("[1.0, 2.0, 3.0]".to_owned()),
+        Just("{}".to_owned()),
+        Just("true".to_owned()),
+        Just("18446744073709551615".to_owned()),
+    ];
+    (0..3usize, 0..n, values, 0..VALID.len()).prop_map(move |(kind, line, value, cut)| match kind {
+        0 => lines
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| *k != line)
+            .map(|(_, l)| l.as_str())
+            .collect::<Vec<_>>()
+            .join("\n"),
+        1 => {
+            let mut cut = cut;
+            while !VALID.is_char_boundary(cut) {
+                cut -= 1;
+            }
+            VALID[..cut].to_owned()
+        }
+        _ => lines
+            .iter()
+            .enumerate()
+            .map(|(k, l)| match (k == line, l.split_once(" = ")) {
+                (true, Some((key, _))) => format!("{key} = {value}"),
+                _ => l.clone(),
+            })
+            .collect::<Vec<_>>()
+            .join("\n"),
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 512, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn mutated_scenes_never_panic(text in mutated()) {
+        if let Ok((scene, src)) = scene::parse(&text, "m.toml", &[]) {
+            let built = match scene::dimension(&scene, &src) {
+                Ok(2) => Problem::<2>::build(&scene, &src, scene.solver.basis.padding()).map(|p| p.len()),
+                Ok(_) => Problem::<3>::build(&scene, &src, scene.solver.basis.padding()).map(|p| p.len()),
+                Err(e) => Err(e),
+            };
+            if let Ok(points) = built {
+                prop_assert!(points > 0);
+                // What builds also runs to an answer or a typed error.
+                if let Ok(problem) = Problem::<2>::build(&scene, &src, scene.solver.basis.padding()) {
+                    let _ = scene::run(&problem, &RunControl::default(), |_, _, _| Ok(()));
+                }
+            }
+        }
+    }
+}
+
+/// The built-in column case and its scene file give the same material
+/// points and the same stresses, bit for bit, for several variants; eq.
+/// (42) is then the same number.
+#[test]
+fn column_scene_equals_the_column_case() {
+    use mpm_cases::cases::column::{self, ColumnParams};
+    use mpm_cases::variant::{BasisKind, DomainUpdateKind, FormulationKind};
+    let text = include_str!("../../../scenes/coombs2020_column.toml");
+    let variants = [
+        (
+            BasisKind::Gimp,
+            DomainUpdateKind::Stretch,
+            FormulationKind::Pc,
+        ),
+        (
+            BasisKind::Linear,
+            DomainUpdateKind::None,
+            FormulationKind::Ul,
+        ),
+        (
+            BasisKind::BSpline2,
+            DomainUpdateKind::None,
+            FormulationKind::Pc,
+        ),
+    ];
+    for (basis, update, formulation) in variants {
+        let params = ColumnParams {
+            basis,
+            domain_update: update,
+            formulation,
+            ..ColumnParams::default()
+        };
+        let case = column::run(
+            &params,
+            &params.variant(),
+            &RunControl::default(),
+            |_, _, _| Ok(()),
+        )
+        .unwrap();
+        let set = [
+            format!("solver.basis={basis}"),
+            format!("solver.domain_update={update}"),
+            format!("solver.formulation={formulation}"),
+        ];
+        let set: Vec<&str> = set.iter().map(String::as_str).collect();
+        let (problem, out) = run2(text, &set);
+        let body = column::geometry(&params, basis.padding()).unwrap().1;
+        assert_eq!(problem.position, body.position, "{basis}");
+        assert_eq!(
+            out.last.sigma, case.output.last.sigma,
+            "{basis} {update} {formulation}"
+        );
+        assert_eq!(out.last.position, case.output.last.position);
+        let z0: Vec<f64> = problem.position.iter().map(|x| x[1]).collect();
+        assert_eq!(params.error(&out.last, &z0, &problem.volume), case.error);
+    }
+}
