@@ -72,30 +72,64 @@ enum Command {
     },
 }
 
-const CASES: [(&str, &str); 6] = [
-    (
+/// A built-in case: its name, what it is, its parameters' defaults (as
+/// TOML) and how it runs from the scene text. Adding a case is one module
+/// in `mpm_cases::cases` and one line here.
+struct CaseEntry {
+    name: &'static str,
+    about: &'static str,
+    defaults: fn() -> Result<String, toml::ser::Error>,
+    run: fn(&str, &str, &[String], &Run) -> Result<()>,
+}
+
+/// `run` of a case whose parameters deserialise from the scene.
+macro_rules! case {
+    ($name:literal, $about:literal, $params:ty, $run:expr) => {
+        CaseEntry {
+            name: $name,
+            about: $about,
+            defaults: || toml::to_string(&<$params>::default()),
+            run: |text, origin, set, run| $run(parse_scene(text, origin, set)?, run),
+        }
+    };
+}
+
+const CASES: [CaseEntry; 6] = [
+    case!(
         "column",
         "Coombs 2020 §7.1: elastic column compacting under self weight (analytic eq. 41, error eq. 42)",
+        column::ColumnParams,
+        |p, run| column_run(&p, run)
     ),
-    (
+    case!(
         "shear",
         "Coombs 2020 §7.2: simple shear of a unit square, elastic or perfectly plastic (homogeneous)",
+        shear::ShearParams,
+        |p, run| shear_run(&p, run)
     ),
-    (
+    case!(
         "cantilever",
         "Coombs 2020 §7.3: elastic cantilever under an end load (tip history, Newton residuals)",
+        cantilever::CantileverParams,
+        |p, run| cantilever_run(&p, run)
     ),
-    (
+    case!(
         "annulus",
         "Coombs 2020 §7.4: elastic annulus under torsion on triangles (manufactured solution, Fig. 19)",
+        annulus::AnnulusParams,
+        annulus_run
     ),
-    (
+    case!(
         "collapse",
         "Coombs 2020 §7.5: elasto-plastic collapse of a block (Tables 6-7)",
+        collapse::CollapseParams,
+        |p, run| collapse_run(&p, run)
     ),
-    (
+    case!(
         "stretch",
         "Wang 2021 §5.3: simple stretch of a cube on tetrahedra with a moving mesh (Table 1)",
+        stretch::StretchParams,
+        stretch_run
     ),
 ];
 
@@ -109,21 +143,20 @@ fn main() {
 fn run_cli(cli: Cli) -> Result<()> {
     match cli.command {
         Command::List => {
-            for (name, about) in CASES {
-                println!("{name}: {about}");
-                let defaults = match name {
-                    "column" => toml::to_string(&column::ColumnParams::default()),
-                    "shear" => toml::to_string(&shear::ShearParams::default()),
-                    "cantilever" => toml::to_string(&cantilever::CantileverParams::default()),
-                    "annulus" => toml::to_string(&annulus::AnnulusParams::default()),
-                    "stretch" => toml::to_string(&stretch::StretchParams::default()),
-                    _ => toml::to_string(&collapse::CollapseParams::default()),
-                }?;
-                for line in defaults.lines() {
-                    println!("    {line}");
+            use std::fmt::Write as _;
+            let mut text = String::new();
+            for case in &CASES {
+                writeln!(text, "{}: {}", case.name, case.about)?;
+                for line in (case.defaults)()?.lines() {
+                    writeln!(text, "    {line}")?;
                 }
             }
-            println!(
+            writeln!(
+                text,
+                "\nscene files without a `case` key describe a whole problem ([mesh], [[material]], [[body]], [[boundary]], [[load]], [[curve]], [solver], [output]): see docs/src/guide/scenes.md and scenes/"
+            )?;
+            writeln!(
+                text,
                 "\nvariant values: basis = {}; formulation = ul | pc; domain_update = {}; gimp_volume = det_f | domain",
                 BasisKind::ALL
                     .iter()
@@ -135,8 +168,12 @@ fn run_cli(cli: Cli) -> Result<()> {
                     .map(|d| d.name())
                     .collect::<Vec<_>>()
                     .join(" | ")
-            );
-            Ok(())
+            )?;
+            // A closed pipe (`mpm list | head`) is not an error.
+            match std::io::Write::write_all(&mut std::io::stdout(), text.as_bytes()) {
+                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+                _ => Ok(()),
+            }
         }
         Command::Run {
             scene,
@@ -185,18 +222,16 @@ fn run_cli(cli: Cli) -> Result<()> {
                     .map(PathBuf::from)
                     .unwrap_or_default(),
             };
-            let result = match name.as_str() {
-                _ if is_scene => scene_run(&text, &origin, &set, &run),
-                "column" => column_run(&parse_scene(&text, &origin, &set)?, &run),
-                "shear" => shear_run(&parse_scene(&text, &origin, &set)?, &run),
-                "cantilever" => cantilever_run(&parse_scene(&text, &origin, &set)?, &run),
-                "collapse" => collapse_run(&parse_scene(&text, &origin, &set)?, &run),
-                "annulus" => annulus_run(parse_scene(&text, &origin, &set)?, &run),
-                "stretch" => stretch_run(parse_scene(&text, &origin, &set)?, &run),
-                other => bail!(
-                    "unknown case `{other}`; cases: {}",
-                    CASES.iter().map(|c| c.0).collect::<Vec<_>>().join(", ")
-                ),
+            let result = if is_scene {
+                scene_run(&text, &origin, &set, &run)
+            } else {
+                match CASES.iter().find(|c| c.name == name) {
+                    Some(case) => (case.run)(&text, &origin, &set, &run),
+                    None => bail!(
+                        "unknown case `{name}`; cases: {}",
+                        CASES.iter().map(|c| c.name).collect::<Vec<_>>().join(", ")
+                    ),
+                }
             };
             match result {
                 Err(e) => match e.downcast_ref::<SolverError>() {

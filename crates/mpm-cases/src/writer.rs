@@ -232,7 +232,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
                 .map_err(|source| CasesError::Mesh { source })?;
         }
         let last = report.lambda1 >= 1.0 - 1e-12;
-        if (step + 1) % self.options.every.max(1) == 0 || last {
+        if (step + 1).is_multiple_of(self.options.every.max(1)) || last {
             self.write_vtu(step, report, snap)?;
         }
         let mut row = vec![

@@ -504,3 +504,111 @@ fn column_scene_equals_the_column_case() {
         assert_eq!(params.error(&out.last, &z0, &problem.volume), case.error);
     }
 }
+
+/// `scenes/features.toml` runs: the prescribed displacement follows its
+/// curve (the pulled end's reaction grows with it), the blocks yield
+/// under their own weight and the point loads, and only the chosen fields
+/// are written.
+#[test]
+fn features_scene_runs_with_every_remaining_key() {
+    let text = include_str!("../../../scenes/features.toml");
+    let (problem, out) = run2(text, &[]);
+    assert_eq!(problem.bodies.len(), 2);
+    assert_eq!(problem.padding, 1);
+    // The hole: no point within 0.5 of its centre.
+    assert!(
+        problem
+            .position
+            .iter()
+            .all(|x| (x - nalgebra::Vector2::new(2.0, 1.0)).norm() > 0.5)
+    );
+    let pulled: Vec<f64> = out.reports.iter().map(|r| r.reaction[0]).collect();
+    assert!(pulled.windows(2).all(|w| w[1] > w[0]), "{pulled:?}");
+    let dir = common::fresh_dir("features_scene");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
+        .args([
+            "run",
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/features.toml"),
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let vtu = std::fs::read_to_string(dir.join("points_0002.vtu")).unwrap();
+    for (name, wanted) in [
+        ("displacement", true),
+        ("cauchy_stress", true),
+        ("equivalent_plastic_strain", true),
+        ("body", true),
+        ("material", true),
+        ("volume", false),
+        ("deformation_gradient", false),
+    ] {
+        assert_eq!(vtu.contains(&format!("Name=\"{name}\"")), wanted, "{name}");
+    }
+    let reactions = std::fs::read_to_string(dir.join("reaction_pulled.csv")).unwrap();
+    assert_eq!(reactions.lines().count(), 1 + out.reports.len());
+}
+
+/// Every key the guide page documents appears in a scene that a test of
+/// this file runs.
+#[test]
+fn every_documented_key_is_exercised() {
+    let guide = include_str!("../../../docs/src/guide/scenes.md");
+    let scenes = [
+        TWO_LAYER,
+        SLOPE,
+        include_str!("../../../scenes/features.toml"),
+        include_str!("../../../scenes/coombs2020_column.toml"),
+    ]
+    .join("\n");
+    let mut keys = Vec::new();
+    for line in guide.lines() {
+        // Table rows whose first cell is a key: "| `key` |".
+        let Some(rest) = line.strip_prefix("| `") else {
+            continue;
+        };
+        let Some((key, _)) = rest.split_once('`') else {
+            continue;
+        };
+        let key = key.trim_start_matches("[[output.").trim_end_matches("]]");
+        if key.contains(' ') || key.contains('{') || key.contains('/') {
+            continue;
+        }
+        keys.push(key.to_owned());
+    }
+    // The region forms of the regions table.
+    keys.extend(
+        [
+            "box",
+            "lower",
+            "upper",
+            "polygon",
+            "sphere",
+            "centre",
+            "radius",
+            "union",
+            "difference",
+        ]
+        .map(String::from),
+    );
+    assert!(keys.len() > 50, "{keys:?}");
+    let missing: Vec<&String> = keys
+        .iter()
+        .filter(|k| {
+            let section = format!("[[output.{k}]]");
+            !(scenes.contains(&format!("{k} ="))
+                || scenes.contains(&format!("{k} = {{"))
+                || scenes.contains(&section))
+        })
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "documented keys no scene uses: {missing:?}"
+    );
+}

@@ -123,6 +123,7 @@ impl<L: LogStrainLaw> LogStrainLaw for MaterialSet<L> {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
     use crate::{HenckyElastic, VonMises};

@@ -737,7 +737,7 @@ impl<const D: usize> Problem<D> {
                     return Err(refuse(key, name));
                 }
             }
-            let mut forces = vec![SVector::<f64, D>::zeros(); 0];
+            let mut forces: Vec<SVector<f64, D>> = Vec::new();
             let add = |p: usize, f: SVector<f64, D>, forces: &mut Vec<SVector<f64, D>>| {
                 if forces.is_empty() {
                     forces.resize(n, SVector::zeros());
