@@ -612,3 +612,55 @@ fn every_documented_key_is_exercised() {
         "documented keys no scene uses: {missing:?}"
     );
 }
+
+/// The built-in collapse case (Coombs et al. 2020 §7.5, Table 6) and its
+/// scene file: the same points and final state bit for bit, so the same
+/// Table 6 figures.
+#[test]
+fn collapse_scene_equals_the_collapse_case() {
+    use mpm_cases::cases::collapse::{self, CollapseParams};
+    let text = include_str!("../../../scenes/coombs2020_collapse.toml");
+    let params = CollapseParams::default();
+    let case = collapse::run(
+        &params,
+        &params.variant(),
+        &RunControl::default(),
+        |_, _, _| Ok(()),
+    )
+    .unwrap();
+    let (problem, out) = run2(text, &[]);
+    let body = collapse::geometry(&params, 0).unwrap().1;
+    assert_eq!(problem.position, body.position);
+    // (Compared with `assert!`: a mismatch would print 1000 tensors.)
+    assert!(
+        out.last.sigma == case.output.last.sigma,
+        "final stresses differ"
+    );
+    assert!(
+        out.last.position == case.output.last.position,
+        "final positions differ"
+    );
+    assert!(
+        out.last.plastic_strain == case.output.last.plastic_strain,
+        "plastic strains differ"
+    );
+    // Table 6 (h = 1 m, 3² points per cell): extent and height at the edge
+    // of the points' initial half-spacing.
+    let edge = |axis: usize| {
+        out.last
+            .position
+            .iter()
+            .zip(&problem.half_lengths)
+            .map(|(x, l)| x[axis] + l[axis])
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    assert_eq!(
+        (edge(0), edge(1)),
+        (case.horizontal_extent, case.max_height)
+    );
+    // Within 1 % as in tests/collapse.rs (measured: 13.669 m, +0.05 %, and
+    // 6.242 m, −0.05 %).
+    let (extent, height) = (edge(0), edge(1));
+    assert!(((extent - 13.662) / 13.662).abs() < 0.01, "{extent}");
+    assert!(((height - 6.245) / 6.245).abs() < 0.01, "{height}");
+}
