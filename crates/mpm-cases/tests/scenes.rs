@@ -664,3 +664,23 @@ fn collapse_scene_equals_the_collapse_case() {
     assert!(((extent - 13.662) / 13.662).abs() < 0.01, "{extent}");
     assert!(((height - 6.245) / 6.245).abs() < 0.01, "{height}");
 }
+
+/// The built-in cantilever case (Coombs et al. 2020 §7.3) and its scene
+/// file: the same loaded points and the same final state bit for bit.
+#[test]
+fn cantilever_scene_equals_the_cantilever_case() {
+    use mpm_cases::cases::cantilever::{self, CantileverParams};
+    let text = include_str!("../../../scenes/coombs2020_cantilever.toml");
+    let params = CantileverParams::default();
+    let case = cantilever::run(&params, &params.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap();
+    let (problem, out) = run2(text, &[]);
+    let (_, body, _, loaded) = cantilever::geometry(&params, 0).unwrap();
+    assert_eq!(problem.position, body.position);
+    let forces: Vec<usize> = problem.point_forces.iter().map(|(p, _)| *p).collect();
+    assert_eq!(forces, loaded.to_vec());
+    assert!(out.last.position == case.output.last.position, "final positions differ");
+    assert!(out.last.sigma == case.output.last.sigma, "final stresses differ");
+    let tip = cantilever::tip_displacement(&out.last, loaded);
+    let (_, ux, uy) = *case.tip.last().unwrap();
+    assert_eq!(tip, (ux, uy));
+}
