@@ -597,12 +597,31 @@ fn scene_run_in<const D: usize>(
     source: &mpm_cases::scene_file::SceneSource,
     run: &Run,
 ) -> Result<()> {
-    use mpm_cases::output::CsvValue;
     use mpm_cases::scene::Problem;
+
+    let problem =
+        Problem::<D>::build_in(scene, source, scene.solver.basis.padding(), &run.scene_dir)?;
+    match &problem.mesh {
+        mpm_cases::scene::build::SceneMesh::Grid(g) => {
+            scene_run_on(scene, &problem, run, g.clone())
+        }
+        mpm_cases::scene::build::SceneMesh::Simplex(m) => {
+            scene_run_on(scene, &problem, run, (**m).clone())
+        }
+    }
+}
+
+/// Runs a built scene, writing its results on the mesh `mesh`.
+fn scene_run_on<const D: usize, M: CellMesh<D>>(
+    scene: &mpm_cases::scene::Scene,
+    problem: &mpm_cases::scene::Problem<D>,
+    run: &Run,
+    mesh: M,
+) -> Result<()> {
+    use mpm_cases::output::CsvValue;
     use mpm_cases::writer::VtuOptions;
 
-    let problem = Problem::<D>::build(scene, source, scene.solver.basis.padding())?;
-    let (mut obs, control) = run.start(scene, problem.grid.clone())?;
+    let (mut obs, control) = run.start(scene, mesh)?;
     obs.writer.set_vtu_options(VtuOptions {
         every: problem.every,
         fields: problem.fields.clone(),
@@ -634,7 +653,7 @@ fn scene_run_in<const D: usize>(
         .collect();
     let mut last_reactions = Map::new();
     let mut last_probes = Map::new();
-    let r = mpm_cases::scene::run(&problem, &control, |s, rep, snap| {
+    let r = mpm_cases::scene::run(problem, &control, |s, rep, snap| {
         let io = |e: mpm_cases::CasesError| SolverError::Observer(ObserverError::new(e));
         for (name, nodes) in &problem.reactions {
             let total = rep

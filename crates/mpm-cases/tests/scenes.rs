@@ -7,6 +7,7 @@ mod common;
 
 use mpm_cases::CasesError;
 use mpm_cases::run::{RunControl, RunOutput};
+use mpm_cases::scene::build::SceneMesh as SceneMeshKind;
 use mpm_cases::scene::{self, Problem};
 use proptest::prelude::*;
 
@@ -565,6 +566,7 @@ fn every_documented_key_is_exercised() {
         SLOPE,
         include_str!("../../../scenes/features.toml"),
         include_str!("../../../scenes/coombs2020_column.toml"),
+        include_str!("../../../scenes/cube_gmsh.toml"),
     ]
     .join("\n");
     let mut keys = Vec::new();
@@ -672,15 +674,127 @@ fn cantilever_scene_equals_the_cantilever_case() {
     use mpm_cases::cases::cantilever::{self, CantileverParams};
     let text = include_str!("../../../scenes/coombs2020_cantilever.toml");
     let params = CantileverParams::default();
-    let case = cantilever::run(&params, &params.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap();
+    let case = cantilever::run(
+        &params,
+        &params.variant(),
+        &RunControl::default(),
+        |_, _, _| Ok(()),
+    )
+    .unwrap();
     let (problem, out) = run2(text, &[]);
     let (_, body, _, loaded) = cantilever::geometry(&params, 0).unwrap();
     assert_eq!(problem.position, body.position);
     let forces: Vec<usize> = problem.point_forces.iter().map(|(p, _)| *p).collect();
     assert_eq!(forces, loaded.to_vec());
-    assert!(out.last.position == case.output.last.position, "final positions differ");
-    assert!(out.last.sigma == case.output.last.sigma, "final stresses differ");
+    assert!(
+        out.last.position == case.output.last.position,
+        "final positions differ"
+    );
+    assert!(
+        out.last.sigma == case.output.last.sigma,
+        "final stresses differ"
+    );
     let tip = cantilever::tip_displacement(&out.last, loaded);
     let (_, ux, uy) = *case.tip.last().unwrap();
     assert_eq!(tip, (ux, uy));
+}
+
+/// Gmsh meshes in scenes: the cube of tetrahedra carries its weight on its
+/// base; a 2D annulus of triangles hangs from its inner rim; the
+/// mesh-specific mistakes are located.
+#[test]
+fn gmsh_scenes_run_on_simplices() {
+    let scenes = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes"));
+    let text = include_str!("../../../scenes/cube_gmsh.toml");
+    let (scene, src) = scene::parse(text, "cube_gmsh.toml", &[]).unwrap();
+    assert_eq!(scene::dimension(&scene, &src).unwrap(), 3);
+    let problem = Problem::<3>::build_in(&scene, &src, 0, scenes).unwrap();
+    let out = scene::run(&problem, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+    let weight = 2000.0 * 10.0 * 8.0;
+    let reaction = out.reports.last().unwrap().reaction[2];
+    assert!((reaction - weight).abs() < 1e-9 * weight, "{reaction}");
+    // Uniaxial strain: σ_zz = −ϱ g (H − Z), to a few per cent on this
+    // coarse mesh (volume-weighted, normalised as eq. 42).
+    let error: f64 = (0..problem.len())
+        .map(|p| {
+            (out.last.sigma[p][8] + 2e4 * (2.0 - problem.position[p][2])).abs() * problem.volume[p]
+        })
+        .sum::<f64>()
+        / (2e4 * 2.0 * 8.0);
+    assert!(error < 0.05, "{error}");
+    eprintln!(
+        "cube of tetrahedra: {} points, stress error {error:.4}",
+        problem.len()
+    );
+
+    let annulus = r#"
+[mesh]
+kind = "gmsh"
+file = "meshes/annulus_0.msh"
+dimension = 2
+
+[[material]]
+name = "m"
+model = "hencky"
+youngs_modulus = 1e6
+poisson_ratio = 0.3
+density = 100.0
+
+[[body]]
+name = "ring"
+material = "m"
+region = { group = "domain" }
+
+[[boundary]]
+set = "inner"
+kind = "fixed"
+
+[[load]]
+kind = "gravity"
+acceleration = [0.0, -10.0]
+
+[solver]
+steps = 2
+formulation = "ul"
+"#;
+    let (scene, src) = scene::parse(annulus, "annulus.toml", &[]).unwrap();
+    let problem = Problem::<2>::build_in(&scene, &src, 0, scenes).unwrap();
+    let out = scene::run(&problem, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+    let mass: f64 = problem.mass.iter().sum();
+    let reaction = out.reports.last().unwrap().reaction[1];
+    assert!(
+        (reaction - 10.0 * mass).abs() < 1e-9 * reaction,
+        "{reaction} {mass}"
+    );
+    // Subdivision(2): four points per triangle.
+    let SceneMeshKind::Simplex(mesh) = &problem.mesh else {
+        panic!("not a simplex mesh")
+    };
+    assert_eq!(problem.len(), 4 * mesh.element_count());
+
+    let refuse = |text: String| {
+        let (scene, src) = scene::parse(&text, "g.toml", &[]).unwrap();
+        Problem::<2>::build_in(&scene, &src, 0, scenes)
+            .unwrap_err()
+            .to_string()
+    };
+    let e = refuse(annulus.replace("annulus_0.msh", "missing.msh"));
+    assert!(
+        e.starts_with("g.toml:4:8: ") && e.contains("missing.msh"),
+        "{e}"
+    );
+    let e = refuse(annulus.replace("group = \"domain\"", "group = \"ring\""));
+    assert!(
+        e.contains("no physical group `ring` of elements; it has: domain"),
+        "{e}"
+    );
+    let e = refuse(annulus.replace("dimension = 2", "dimension = 2\ncells = [2, 2]"));
+    assert!(e.contains("apply to kind = \"grid\" meshes"), "{e}");
+    let e = refuse(annulus.replace("steps = 2", "steps = 2\nbasis = \"gimp\""));
+    assert!(e.contains("standard MPM"), "{e}");
+    let e = refuse(annulus.replace("set = \"inner\"", "set = \"rim\""));
+    assert!(
+        e.contains("no node set named `rim`") && e.contains("inner") && e.contains("outer"),
+        "{e}"
+    );
 }

@@ -6,7 +6,7 @@
 
 use std::collections::BTreeMap;
 
-use mpm_mesh::RegularGrid;
+use mpm_mesh::{RegularGrid, SimplexMesh};
 use mpm_solver::{Constraints, LoadStepping, NewtonOptions};
 use nalgebra::SVector;
 use toml::Spanned;
@@ -17,7 +17,7 @@ use crate::run::HistoryOutput;
 use crate::scene_file::SceneSource;
 use crate::variant::Variant;
 
-use super::format::{BoundaryKind, Field, LoadKind, Scene};
+use super::format::{BoundaryKind, Field, LoadKind, MeshKind, RegionSpec, Scene};
 use super::region::{Region, point};
 
 /// Largest number of grid nodes or material points a scene may ask for
@@ -96,6 +96,33 @@ impl<const D: usize> Constraints<D> for SceneConstraints<D> {
     }
 }
 
+/// The background mesh of a scene.
+#[derive(Debug, Clone)]
+pub enum SceneMesh<const D: usize> {
+    /// A regular grid.
+    Grid(RegularGrid<D>),
+    /// Linear triangles or tetrahedra.
+    Simplex(Box<SimplexMesh<D>>),
+}
+
+impl<const D: usize> SceneMesh<D> {
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        match self {
+            SceneMesh::Grid(g) => g.node_count(),
+            SceneMesh::Simplex(m) => m.node_count(),
+        }
+    }
+
+    /// Position of node `v` (the origin for an id out of range).
+    pub fn node_position(&self, v: usize) -> SVector<f64, D> {
+        match self {
+            SceneMesh::Grid(g) => g.node_position(v).unwrap_or_else(|_| SVector::zeros()),
+            SceneMesh::Simplex(m) => m.nodes().get(v).copied().unwrap_or_else(SVector::zeros),
+        }
+    }
+}
+
 /// One body of the built scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BuiltBody {
@@ -136,8 +163,8 @@ pub struct CurvedForces<const D: usize> {
 /// A scene ready to run.
 #[derive(Debug, Clone)]
 pub struct Problem<const D: usize> {
-    /// The grid, padding included.
-    pub grid: RegularGrid<D>,
+    /// The background mesh (a grid with its padding, or simplices).
+    pub mesh: SceneMesh<D>,
     /// Padding cells on every side.
     pub padding: usize,
     /// The bodies, in file order; their points are consecutive.
@@ -284,6 +311,24 @@ impl<const D: usize> Problem<D> {
         src: &SceneSource,
         basis_padding: usize,
     ) -> Result<Self, CasesError> {
+        let dir = std::path::Path::new(src.origin())
+            .parent()
+            .map(std::path::Path::to_path_buf)
+            .unwrap_or_default();
+        Self::build_in(scene, src, basis_padding, &dir)
+    }
+
+    /// [`Self::build`] with Gmsh files relative to `mesh_dir` (the
+    /// scene file's directory).
+    ///
+    /// # Errors
+    /// As [`Self::build`].
+    pub fn build_in(
+        scene: &Scene,
+        src: &SceneSource,
+        basis_padding: usize,
+        mesh_dir: &std::path::Path,
+    ) -> Result<Self, CasesError> {
         let check = Check { src };
         let variant = Variant {
             basis: scene.solver.basis,
@@ -295,90 +340,58 @@ impl<const D: usize> Problem<D> {
 
         // Mesh.
         let m = &scene.mesh;
-        let origin = point::<D>(&m.origin, "mesh `origin`", src)?;
-        let size = point::<D>(&m.size, "mesh `size`", src)?;
-        if let Some(axis) = (0..D).find(|&i| size[i] <= 0.0) {
-            return Err(src.at(
-                &m.size,
-                format!(
-                    "mesh `size` must be positive on every axis ({} is {})",
-                    AXES[axis], size[axis]
-                ),
-            ));
-        }
-        let cells: [usize; D] = match (&m.cells, &m.spacing) {
-            (Some(c), None) => {
-                if c.get_ref().len() != D {
-                    return Err(src.at(
-                        c,
-                        format!(
-                            "mesh `cells` has {} entries; the scene is {D}D",
-                            c.get_ref().len()
-                        ),
+        let (mesh, origin, upper, padding) = match m.kind {
+            MeshKind::Grid => {
+                if let Some(f) = m.file.as_ref() {
+                    return Err(src.at(f, "`file` applies to kind = \"gmsh\" meshes"));
+                }
+                if let Some(d) = m.dimension.as_ref() {
+                    return Err(src.at(d, "`dimension` applies to kind = \"gmsh\" meshes (a grid's is the length of `origin`)"));
+                }
+                let (Some(origin), Some(size)) = (&m.origin, &m.size) else {
+                    return Err(src.error(
+                        None,
+                        "[mesh]: a grid needs `origin`, `size` and `cells` or `spacing`",
                     ));
-                }
-                if c.get_ref().contains(&0) {
-                    return Err(src.at(c, "mesh `cells` must be at least 1 on every axis"));
-                }
-                std::array::from_fn(|i| c.get_ref()[i])
+                };
+                let (grid, origin, upper, padding) =
+                    grid_mesh::<D>(m, origin, size, basis_padding, &variant, src)?;
+                (SceneMesh::Grid(grid), origin, upper, padding)
             }
-            (None, Some(h)) => {
-                let h_v = point::<D>(h, "mesh `spacing`", src)?;
-                let mut cells = [0usize; D];
-                for i in 0..D {
-                    let n = size[i] / h_v[i];
-                    if !(h_v[i] > 0.0
-                        && n.is_finite()
-                        && n >= 0.5
-                        && (n - n.round()).abs() <= 1e-9 * n.max(1.0))
-                    {
-                        return Err(src.at(
-                            h,
-                            format!(
-                                "mesh `spacing` {} must be positive and divide the size {} along {}",
-                                h_v[i], size[i], AXES[i]
-                            ),
-                        ));
-                    }
-                    cells[i] = n.round() as usize;
+            MeshKind::Gmsh => {
+                let grid_key = [
+                    m.origin.as_ref().map(Spanned::span),
+                    m.size.as_ref().map(Spanned::span),
+                    m.cells.as_ref().map(Spanned::span),
+                    m.spacing.as_ref().map(Spanned::span),
+                    m.padding.as_ref().map(Spanned::span),
+                ]
+                .into_iter()
+                .flatten()
+                .next();
+                if let Some(span) = grid_key {
+                    return Err(src.error(Some(span), "`origin`, `size`, `cells`, `spacing` and `padding` apply to kind = \"grid\" meshes"));
                 }
-                cells
-            }
-            (Some(c), Some(_)) => {
-                return Err(src.at(c, "give mesh `cells` or `spacing`, not both"));
-            }
-            (None, None) => {
-                return Err(src.at(&m.size, "the mesh needs `cells` or `spacing`"));
+                let Some(file) = &m.file else {
+                    return Err(src.error(None, "[mesh]: a Gmsh mesh needs `file` and `dimension`"));
+                };
+                if let Err(reason) = variant.require_standard_mpm("a Gmsh mesh") {
+                    return Err(src.at(file, reason));
+                }
+                let path = mesh_dir.join(file.get_ref());
+                let read = mpm_mesh::read_msh::<D>(&path)
+                    .map_err(|e| src.at(file, format!("{}: {e}", path.display())))?;
+                let simplices = match read.elements {
+                    mpm_mesh::GmshElements::Linear(mesh) => mesh,
+                    mpm_mesh::GmshElements::Quadratic(q) => mpm_mesh::PatchMesh::from_parents(&q)
+                        .map_err(|e| src.at(file, format!("{}: {e}", path.display())))?
+                        .into_mesh(),
+                };
+                let b = *simplices.bounding_box();
+                (SceneMesh::Simplex(Box::new(simplices)), b.lower, b.upper, 0)
             }
         };
-        let padding = match &m.padding {
-            Some(p) if *p.get_ref() < basis_padding => {
-                return Err(src.at(
-                    p,
-                    format!(
-                        "basis = {} needs {basis_padding} padding cell(s), got {}",
-                        variant.basis,
-                        p.get_ref()
-                    ),
-                ));
-            }
-            Some(p) => *p.get_ref(),
-            None => basis_padding,
-        };
-        let spacing = SVector::<f64, D>::from_fn(|i, _| size[i] / cells[i] as f64);
-        let padded: [usize; D] = std::array::from_fn(|i| cells[i].saturating_add(2 * padding));
-        let nodes = padded
-            .iter()
-            .try_fold(1usize, |n, &c| n.checked_mul(c.saturating_add(1)));
-        if nodes.is_none_or(|n| n > MAX_ENTITIES) {
-            return Err(src.at(
-                m.cells.as_ref().map_or(&m.size, |_| &m.size),
-                format!("the grid would have more than {MAX_ENTITIES} nodes"),
-            ));
-        }
-        let grid = RegularGrid::new(origin - spacing * padding as f64, spacing, padded)
-            .map_err(|e| src.at(&m.origin, format!("mesh: {e}")))?;
-        let upper = origin + size;
+        let size = upper - origin;
         let tol = 1e-9 * size.max();
 
         // Curves (index 0: the default ramp).
@@ -470,37 +483,123 @@ impl<const D: usize> Problem<D> {
             return Err(src.error(None, "a scene needs at least one [[body]]"));
         }
         unique_names(scene.bodies.iter().map(|b| &b.name), "body", src)?;
-        let mut regions = Vec::new();
+        let mut regions: Vec<Option<Region<D>>> = Vec::new();
         let mut problem_points = Points::<D>::default();
         let mut bodies = Vec::new();
+        let mut element_owner: Vec<Option<usize>> = match &mesh {
+            SceneMesh::Simplex(sm) => vec![None; sm.element_count()],
+            SceneMesh::Grid(_) => Vec::new(),
+        };
         for (b, spec) in scene.bodies.iter().enumerate() {
             let material = lookup(&material_names, &spec.material, "material", src)?;
-            let region = Region::<D>::new(&spec.region, src)?;
-            let (lo, hi) = region.bounds();
-            if (0..D).any(|i| lo[i] < origin[i] - tol || hi[i] > upper[i] + tol) {
-                return Err(src.at(
-                    &spec.name,
-                    format!(
-                        "body `{}` reaches outside the mesh: its region spans {:?} to {:?}, the mesh {:?} to {:?}",
-                        spec.name.get_ref(),
-                        lo.as_slice(),
-                        hi.as_slice(),
-                        origin.as_slice(),
-                        upper.as_slice()
-                    ),
-                ));
+            let region = match (&spec.region, &mesh) {
+                (RegionSpec::Group(_), SceneMesh::Simplex(_)) => None,
+                (other, _) => Some(Region::<D>::new(other, src)?),
+            };
+            if let Some(region) = &region {
+                let (lo, hi) = region.bounds();
+                if (0..D).any(|i| lo[i] < origin[i] - tol || hi[i] > upper[i] + tol) {
+                    return Err(src.at(
+                        &spec.name,
+                        format!(
+                            "body `{}` reaches outside the mesh: its region spans {:?} to {:?}, the mesh {:?} to {:?}",
+                            spec.name.get_ref(),
+                            lo.as_slice(),
+                            hi.as_slice(),
+                            origin.as_slice(),
+                            upper.as_slice()
+                        ),
+                    ));
+                }
             }
             let ppc = check.at_least(&spec.points_per_cell, 1, "points_per_cell")?;
             let start = problem_points.position.len();
-            let step = problem_points.fill(
-                &grid,
-                padding,
-                cells,
-                &region,
-                ppc,
-                src,
-                &spec.points_per_cell,
-            )?;
+            let step = match &mesh {
+                SceneMesh::Grid(grid) => {
+                    let cells: [usize; D] =
+                        std::array::from_fn(|i| grid.cells_per_axis()[i] - 2 * padding);
+                    let Some(region) = &region else {
+                        return Err(src.error(None, "internal: a grid body without a region"));
+                    };
+                    problem_points
+                        .fill(
+                            grid,
+                            padding,
+                            cells,
+                            region,
+                            ppc,
+                            src,
+                            &spec.points_per_cell,
+                        )?
+                        .as_slice()
+                        .to_vec()
+                }
+                SceneMesh::Simplex(sm) => {
+                    let elements: Vec<usize> = match (&spec.region, &region) {
+                        (RegionSpec::Group(name), _) => sm
+                            .element_sets()
+                            .get(name.get_ref())
+                            .ok_or_else(|| {
+                                src.at(
+                                    name,
+                                    format!(
+                                        "the mesh has no physical group `{}` of elements; it has: {}",
+                                        name.get_ref(),
+                                        sm.element_sets().names().collect::<Vec<_>>().join(", ")
+                                    ),
+                                )
+                            })?
+                            .to_vec(),
+                        (_, Some(region)) => (0..sm.element_count())
+                            .filter(|&e| {
+                                let nodes = sm.element_nodes(e);
+                                let c = nodes.iter().fold(SVector::<f64, D>::zeros(), |c, &v| c + sm.nodes()[v])
+                                    / nodes.len() as f64;
+                                region.contains(&c)
+                            })
+                            .collect(),
+                        (_, None) => Vec::new(),
+                    };
+                    let per_element = ppc.checked_pow(D as u32).unwrap_or(usize::MAX);
+                    if elements
+                        .len()
+                        .saturating_mul(per_element)
+                        .saturating_add(start)
+                        > MAX_ENTITIES
+                    {
+                        return Err(src.at(
+                            &spec.points_per_cell,
+                            format!(
+                                "the scene would hold more than {MAX_ENTITIES} material points"
+                            ),
+                        ));
+                    }
+                    for &e in &elements {
+                        if let Some(other) = element_owner[e] {
+                            return Err(src.at(
+                                &spec.name,
+                                format!(
+                                    "body `{}` overlaps body `{}` (both hold element {e}); bodies may touch but not overlap",
+                                    spec.name.get_ref(),
+                                    scene.bodies[other].name.get_ref()
+                                ),
+                            ));
+                        }
+                        element_owner[e] = Some(b);
+                    }
+                    let body = crate::body::Body::fill_simplices(
+                        sm,
+                        &elements,
+                        crate::body::SimplexRule::Subdivision(ppc),
+                    );
+                    problem_points.position.extend_from_slice(&body.position);
+                    problem_points.volume.extend_from_slice(&body.volume);
+                    problem_points
+                        .half_lengths
+                        .extend_from_slice(&body.half_lengths);
+                    Vec::new()
+                }
+            };
             let end = problem_points.position.len();
             if end == start {
                 return Err(src.at(
@@ -511,20 +610,22 @@ impl<const D: usize> Problem<D> {
                     ),
                 ));
             }
-            for p in start..end {
-                if let Some(other) = regions
-                    .iter()
-                    .position(|r: &Region<D>| r.contains(&problem_points.position[p]))
-                {
-                    return Err(src.at(
-                        &spec.name,
-                        format!(
-                            "body `{}` overlaps body `{}` (both hold {:?}); bodies may touch but not overlap",
-                            spec.name.get_ref(),
-                            scene.bodies[other].name.get_ref(),
-                            problem_points.position[p].as_slice()
-                        ),
-                    ));
+            if matches!(mesh, SceneMesh::Grid(_)) {
+                for p in start..end {
+                    if let Some(other) = regions.iter().position(|r| {
+                        r.as_ref()
+                            .is_some_and(|r| r.contains(&problem_points.position[p]))
+                    }) {
+                        return Err(src.at(
+                            &spec.name,
+                            format!(
+                                "body `{}` overlaps body `{}` (both hold {:?}); bodies may touch but not overlap",
+                                spec.name.get_ref(),
+                                scene.bodies[other].name.get_ref(),
+                                problem_points.position[p].as_slice()
+                            ),
+                        ));
+                    }
                 }
             }
             let density = materials[material].density;
@@ -538,7 +639,7 @@ impl<const D: usize> Problem<D> {
                 name: spec.name.get_ref().clone(),
                 material,
                 points: start..end,
-                step: step.as_slice().to_vec(),
+                step,
             });
         }
         let body_names: BTreeMap<String, usize> = bodies
@@ -550,7 +651,7 @@ impl<const D: usize> Problem<D> {
 
         // Node sets: the faces, then the named ones.
         let mut sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
-        let node_position = |v: usize| grid.node_position(v).unwrap_or_else(|_| SVector::zeros());
+        let node_position = |v: usize| mesh.node_position(v);
         for axis in 0..D {
             for upper_face in [false, true] {
                 let bound = if upper_face {
@@ -558,7 +659,7 @@ impl<const D: usize> Problem<D> {
                 } else {
                     origin[axis]
                 };
-                let nodes = (0..grid.node_count())
+                let nodes = (0..mesh.node_count())
                     .filter(|&v| {
                         let x = node_position(v)[axis];
                         if upper_face {
@@ -572,6 +673,13 @@ impl<const D: usize> Problem<D> {
             }
         }
         let faces: Vec<String> = sets.keys().cloned().collect();
+        if let SceneMesh::Simplex(sm) = &mesh {
+            // The mesh's physical groups, unless a face has their name.
+            for (name, nodes) in sm.node_sets().iter() {
+                sets.entry(name.to_owned())
+                    .or_insert_with(|| nodes.to_vec());
+            }
+        }
         for spec in &scene.node_sets {
             if sets.contains_key(spec.name.get_ref()) {
                 return Err(src.at(
@@ -583,7 +691,7 @@ impl<const D: usize> Problem<D> {
                 ));
             }
             let region = Region::<D>::new(&spec.region, src)?;
-            let nodes: Vec<usize> = (0..grid.node_count())
+            let nodes: Vec<usize> = (0..mesh.node_count())
                 .filter(|&v| region.contains(&node_position(v)))
                 .collect();
             if nodes.is_empty() {
@@ -608,7 +716,7 @@ impl<const D: usize> Problem<D> {
         };
 
         // Boundaries (later conditions replace earlier ones on shared dofs).
-        let mut dofs: Vec<Option<(f64, u16)>> = vec![None; grid.node_count() * D];
+        let mut dofs: Vec<Option<(f64, u16)>> = vec![None; mesh.node_count() * D];
         for spec in &scene.boundaries {
             let nodes = set_of(&spec.set)?;
             let mut prescribe = |component: usize, value: f64, curve: usize| {
@@ -813,6 +921,18 @@ impl<const D: usize> Problem<D> {
                         );
                     };
                     let body = &bodies[k];
+                    let Some(body_region) = &regions[k] else {
+                        return Err(src.at(
+                            &spec.kind,
+                            "traction loads need a body given by a region on a grid",
+                        ));
+                    };
+                    if body.step.is_empty() {
+                        return Err(src.at(
+                            &spec.kind,
+                            "traction loads need a body on a grid (simplex bodies have no lattice)",
+                        ));
+                    }
                     let mut offset = SVector::<f64, D>::zeros();
                     offset[axis] = if up {
                         body.step[axis]
@@ -822,7 +942,7 @@ impl<const D: usize> Problem<D> {
                     let mut loaded = 0;
                     for p in body.points.clone() {
                         let x = problem_points.position[p];
-                        if !regions[k].contains(&(x + offset)) {
+                        if !body_region.contains(&(x + offset)) {
                             // The point's face area on that side.
                             let area = problem_points.volume[p] / body.step[axis];
                             add(p, t * area, &mut forces);
@@ -948,7 +1068,7 @@ impl<const D: usize> Problem<D> {
         });
 
         Ok(Self {
-            grid,
+            mesh,
             padding,
             bodies,
             materials,
@@ -986,6 +1106,104 @@ impl<const D: usize> Problem<D> {
     pub fn is_empty(&self) -> bool {
         self.position.is_empty()
     }
+}
+
+/// The regular grid of `[mesh]`: its cells (or spacing), padding and
+/// origin; returns the grid, the unpadded box and the padding.
+fn grid_mesh<const D: usize>(
+    m: &super::format::MeshSpec,
+    origin_spec: &Spanned<Vec<f64>>,
+    size_spec: &Spanned<Vec<f64>>,
+    basis_padding: usize,
+    variant: &Variant,
+    src: &SceneSource,
+) -> Result<(RegularGrid<D>, SVector<f64, D>, SVector<f64, D>, usize), CasesError> {
+    let origin_v = point::<D>(origin_spec, "mesh `origin`", src)?;
+    let size = point::<D>(size_spec, "mesh `size`", src)?;
+    let origin = origin_v;
+    if let Some(axis) = (0..D).find(|&i| size[i] <= 0.0) {
+        return Err(src.at(
+            size_spec,
+            format!(
+                "mesh `size` must be positive on every axis ({} is {})",
+                AXES[axis], size[axis]
+            ),
+        ));
+    }
+    let cells: [usize; D] = match (&m.cells, &m.spacing) {
+        (Some(c), None) => {
+            if c.get_ref().len() != D {
+                return Err(src.at(
+                    c,
+                    format!(
+                        "mesh `cells` has {} entries; the scene is {D}D",
+                        c.get_ref().len()
+                    ),
+                ));
+            }
+            if c.get_ref().contains(&0) {
+                return Err(src.at(c, "mesh `cells` must be at least 1 on every axis"));
+            }
+            std::array::from_fn(|i| c.get_ref()[i])
+        }
+        (None, Some(h)) => {
+            let h_v = point::<D>(h, "mesh `spacing`", src)?;
+            let mut cells = [0usize; D];
+            for i in 0..D {
+                let n = size[i] / h_v[i];
+                if !(h_v[i] > 0.0
+                    && n.is_finite()
+                    && n >= 0.5
+                    && (n - n.round()).abs() <= 1e-9 * n.max(1.0))
+                {
+                    return Err(src.at(
+                        h,
+                        format!(
+                            "mesh `spacing` {} must be positive and divide the size {} along {}",
+                            h_v[i], size[i], AXES[i]
+                        ),
+                    ));
+                }
+                cells[i] = n.round() as usize;
+            }
+            cells
+        }
+        (Some(c), Some(_)) => {
+            return Err(src.at(c, "give mesh `cells` or `spacing`, not both"));
+        }
+        (None, None) => {
+            return Err(src.at(size_spec, "the mesh needs `cells` or `spacing`"));
+        }
+    };
+    let padding = match &m.padding {
+        Some(p) if *p.get_ref() < basis_padding => {
+            return Err(src.at(
+                p,
+                format!(
+                    "basis = {} needs {basis_padding} padding cell(s), got {}",
+                    variant.basis,
+                    p.get_ref()
+                ),
+            ));
+        }
+        Some(p) => *p.get_ref(),
+        None => basis_padding,
+    };
+    let spacing = SVector::<f64, D>::from_fn(|i, _| size[i] / cells[i] as f64);
+    let padded: [usize; D] = std::array::from_fn(|i| cells[i].saturating_add(2 * padding));
+    let nodes = padded
+        .iter()
+        .try_fold(1usize, |n, &c| n.checked_mul(c.saturating_add(1)));
+    if nodes.is_none_or(|n| n > MAX_ENTITIES) {
+        return Err(src.at(
+            m.cells.as_ref().map_or(size_spec, |_| size_spec),
+            format!("the grid would have more than {MAX_ENTITIES} nodes"),
+        ));
+    }
+    let grid = RegularGrid::new(origin - spacing * padding as f64, spacing, padded)
+        .map_err(|e| src.at(origin_spec, format!("mesh: {e}")))?;
+    let upper = origin + size;
+    Ok((grid, origin, upper, padding))
 }
 
 /// Point arrays while the bodies are filled.

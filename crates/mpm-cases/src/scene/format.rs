@@ -55,29 +55,41 @@ pub enum MeshKind {
     /// A regular grid of squares or cubes.
     #[default]
     Grid,
+    /// A Gmsh MSH 4.1 file of triangles or tetrahedra (linear, or
+    /// quadratic split into their linear children).
+    Gmsh,
 }
 
-/// `[mesh]`: a regular grid over the box `origin .. origin + size`.
+/// `[mesh]`: a regular grid over the box `origin .. origin + size`, or a
+/// Gmsh file.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
-    /// The kind of mesh (`grid`).
+    /// The kind of mesh (`grid` or `gmsh`).
     #[serde(default)]
     pub kind: MeshKind,
-    /// Lower corner (m); its length (2 or 3) sets the dimension.
-    pub origin: Spanned<Vec<f64>>,
-    /// Extent per axis (m).
-    pub size: Spanned<Vec<f64>>,
-    /// Cells per axis (give this or `spacing`).
+    /// Grid: lower corner (m); its length (2 or 3) sets the dimension.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<Spanned<Vec<f64>>>,
+    /// Grid: extent per axis (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size: Option<Spanned<Vec<f64>>>,
+    /// Grid: cells per axis (give this or `spacing`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cells: Option<Spanned<Vec<usize>>>,
-    /// Cell size per axis (m), dividing `size` (give this or `cells`).
+    /// Grid: cell size per axis (m), dividing `size` (give this or `cells`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spacing: Option<Spanned<Vec<f64>>>,
-    /// Extra cells on every side beyond the box; at least what the basis
-    /// needs (one for quadratic B-splines), which is also the default.
+    /// Grid: extra cells on every side beyond the box; at least what the
+    /// basis needs (one for quadratic B-splines), which is also the default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub padding: Option<Spanned<usize>>,
+    /// Gmsh: the MSH 4.1 file, relative to the scene file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<Spanned<String>>,
+    /// Gmsh: the dimension (2 or 3).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dimension: Option<Spanned<usize>>,
 }
 
 /// `[[material]]`.
@@ -127,6 +139,8 @@ pub enum RegionSpec {
     Union(Vec<RegionSpec>),
     /// Points in the first region and in none of the others.
     Difference(Spanned<Vec<RegionSpec>>),
+    /// The elements of a Gmsh physical group (Gmsh meshes; bodies only).
+    Group(Spanned<String>),
 }
 
 /// `[[body]]`: material points filling a region.
@@ -139,8 +153,10 @@ pub struct BodySpec {
     pub material: Spanned<String>,
     /// Where its points are.
     pub region: RegionSpec,
-    /// Points per cell per axis (on a regular lattice: each point at the
-    /// centre of its sub-cell, kept when the centre is in the region).
+    /// Grids: points per cell per axis (on a regular lattice: each point
+    /// at the centre of its sub-cell, kept when the centre is in the
+    /// region). Simplex meshes: each element split into `n^D` equal
+    /// sub-simplices, one point at each centroid.
     #[serde(default = "default_points_per_cell")]
     pub points_per_cell: Spanned<usize>,
 }

@@ -81,16 +81,32 @@ pub fn parse(
     parse_scene_located(text, origin, overrides)
 }
 
-/// The dimension of a scene: the length of its mesh origin, if 2 or 3.
+/// The dimension of a scene: the length of its grid origin, or the
+/// `dimension` of its Gmsh mesh, if 2 or 3.
 ///
 /// # Errors
-/// [`CasesError::Scene`] at the origin otherwise.
+/// [`CasesError::Scene`] at the origin or dimension otherwise,
+/// [`CasesError::SceneUnlocated`] when the mesh gives neither.
 pub fn dimension(scene: &Scene, source: &SceneSource) -> Result<usize, CasesError> {
-    match scene.mesh.origin.get_ref().len() {
-        d @ (2 | 3) => Ok(d),
-        d => Err(source.at(
-            &scene.mesh.origin,
-            format!("mesh `origin` has {d} components; scenes are 2D or 3D"),
+    let m = &scene.mesh;
+    let (d, at) = match (m.kind, &m.origin, &m.dimension) {
+        (format::MeshKind::Grid, Some(origin), _) => (origin.get_ref().len(), origin.span()),
+        (format::MeshKind::Gmsh, _, Some(d)) => (*d.get_ref(), d.span()),
+        (format::MeshKind::Grid, None, _) => {
+            return Err(source.error(
+                None,
+                "[mesh]: a grid needs `origin`, `size` and `cells` or `spacing`",
+            ));
+        }
+        (format::MeshKind::Gmsh, _, None) => {
+            return Err(source.error(None, "[mesh]: a Gmsh mesh needs `file` and `dimension`"));
+        }
+    };
+    match d {
+        2 | 3 => Ok(d),
+        _ => Err(source.error(
+            Some(at),
+            &format!("the mesh has dimension {d}; scenes are 2D or 3D"),
         )),
     }
 }

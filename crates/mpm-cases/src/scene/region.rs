@@ -120,6 +120,12 @@ impl<const D: usize> Region<D> {
                         .collect::<Result<_, _>>()?,
                 )
             }
+            RegionSpec::Group(name) => {
+                return Err(src.at(
+                    name,
+                    "a `group` region selects a Gmsh physical group: it applies to bodies on a Gmsh mesh only",
+                ));
+            }
             RegionSpec::Difference(parts) => {
                 if parts.get_ref().is_empty() {
                     return Err(src.at(parts, "a difference needs at least one region"));

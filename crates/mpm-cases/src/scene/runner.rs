@@ -5,10 +5,12 @@
 
 use std::sync::Arc;
 
+use mpm_basis::LinearSimplex;
 use mpm_constitutive::LogStrainLaw;
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    BodyForcePath, DomainUpdater, Flat, Formulation, MaterialPoints, SolverError, StepReport,
+    BodyForcePath, DomainUpdater, Flat, Formulation, MaterialPoints, MovableMesh, NoUpdate,
+    PreviouslyConverged, SolverError, StepReport, UpdatedLagrangian,
 };
 use nalgebra::SVector;
 
@@ -17,9 +19,9 @@ use crate::material::{LawVisitor, MaterialTag, dispatch_law, dispatch_law_set};
 use crate::run::{
     Analysis, DomainBounds, HistoryOutput, RunControl, RunOutput, Snapshot, simulate_points,
 };
-use crate::variant::{VariantVisitor, dispatch};
+use crate::variant::{FormulationKind, VariantVisitor, dispatch};
 
-use super::build::Problem;
+use super::build::{Problem, SceneMesh};
 
 /// Runs `problem`; `observer` sees every converged step.
 ///
@@ -35,24 +37,48 @@ pub fn run<const D: usize, O>(
 where
     O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
-    dispatch(
-        &problem.variant,
-        WithVariant {
-            problem,
-            control,
-            observer,
-        },
-    )
-    .map_err(SolverError::InvalidInput)?
+    match &problem.mesh {
+        SceneMesh::Grid(grid) => dispatch(
+            &problem.variant,
+            WithVariant {
+                problem,
+                mesh: grid,
+                control,
+                observer,
+            },
+        )
+        .map_err(SolverError::InvalidInput)?,
+        SceneMesh::Simplex(mesh) => {
+            problem
+                .variant
+                .require_standard_mpm("a simplex mesh")
+                .map_err(SolverError::InvalidInput)?;
+            let run = WithVariant {
+                problem,
+                mesh: &**mesh,
+                control,
+                observer,
+            };
+            match problem.variant.formulation {
+                FormulationKind::Pc => {
+                    run.with::<LinearSimplex, PreviouslyConverged, _>(LinearSimplex, NoUpdate)
+                }
+                FormulationKind::Ul => {
+                    run.with::<LinearSimplex, UpdatedLagrangian, _>(LinearSimplex, NoUpdate)
+                }
+            }
+        }
+    }
 }
 
-struct WithVariant<'a, const D: usize, O> {
+struct WithVariant<'a, const D: usize, M, O> {
     problem: &'a Problem<D>,
+    mesh: &'a M,
     control: &'a RunControl,
     observer: O,
 }
 
-impl<const D: usize, O> VariantVisitor<D> for WithVariant<'_, D, O>
+impl<const D: usize, O> VariantVisitor<D> for WithVariant<'_, D, RegularGrid<D>, O>
 where
     O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
@@ -64,9 +90,26 @@ where
         F: Formulation,
         U: DomainUpdater<D, B::Domain>,
     {
+        self.with::<B, F, U>(basis, updater)
+    }
+}
+
+impl<const D: usize, M, O> WithVariant<'_, D, M, O>
+where
+    M: MovableMesh<D> + Clone,
+    O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
+{
+    /// Runs with basis `B` (on mesh `M`), formulation `F`, updater `U` and
+    /// the scene's materials.
+    fn with<B, F, U>(self, basis: B, updater: U) -> Result<RunOutput<D>, SolverError>
+    where
+        B: InitialDomain<D, Mesh = M, Domain: Flat + DomainBounds<D>>,
+        F: Formulation,
+        U: DomainUpdater<D, B::Domain>,
+    {
         let materials = &self.problem.materials;
         let model = materials[0].model;
-        let with_law = WithLaw::<D, B, F, U, O> {
+        let with_law = WithLaw::<D, M, B, F, U, O> {
             run: self,
             basis,
             updater,
@@ -81,16 +124,17 @@ where
     }
 }
 
-struct WithLaw<'a, const D: usize, B, F, U, O> {
-    run: WithVariant<'a, D, O>,
+struct WithLaw<'a, const D: usize, M, B, F, U, O> {
+    run: WithVariant<'a, D, M, O>,
     basis: B,
     updater: U,
     formulation: std::marker::PhantomData<F>,
 }
 
-impl<const D: usize, B, F, U, O> LawVisitor for WithLaw<'_, D, B, F, U, O>
+impl<const D: usize, M, B, F, U, O> LawVisitor for WithLaw<'_, D, M, B, F, U, O>
 where
-    B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>,
+    M: MovableMesh<D> + Clone,
+    B: InitialDomain<D, Mesh = M, Domain: Flat + DomainBounds<D>>,
     F: Formulation,
     U: DomainUpdater<D, B::Domain>,
     O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
@@ -130,7 +174,7 @@ where
             })));
         }
         let analysis = Analysis {
-            grid: p.grid.clone(),
+            grid: self.run.mesh.clone(),
             law,
             constraints: p.constraints.clone(),
             stepping: p.stepping,
