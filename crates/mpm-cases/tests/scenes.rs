@@ -23,6 +23,43 @@ fn run2(text: &str, overrides: &[&str]) -> (Problem<2>, RunOutput<2>) {
     (problem, out)
 }
 
+/// Runs `mpm run scenes/<file> --out <fresh dir>`; returns the directory
+/// after checking the program succeeded.
+fn run_mpm(file: &str, test: &str) -> std::path::PathBuf {
+    let dir = common::fresh_dir(test);
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(file);
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
+        .arg("run")
+        .arg(scene)
+        .arg("--out")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    dir
+}
+
+/// The final states of a scene run and of the built-in case it mirrors are
+/// the same, bit for bit (compared with `assert!`: a mismatch would print
+/// a thousand tensors).
+fn assert_same_final_state(scene: &RunOutput<2>, case: &RunOutput<2>) {
+    assert!(
+        scene.last.position == case.last.position,
+        "final positions differ"
+    );
+    assert!(scene.last.sigma == case.last.sigma, "final stresses differ");
+    assert!(
+        scene.last.plastic_strain == case.last.plastic_strain,
+        "plastic strains differ"
+    );
+}
+
 /// The error of a scene that must not build, as text.
 fn refusal(text: &str) -> String {
     let built =
@@ -174,21 +211,7 @@ fn slope_runs_with_its_curves_and_writes_png_and_vtu() {
             .any(|p| out.last.plastic_strain[p] > 1e-4)
     );
 
-    let dir = common::fresh_dir("slope_scene");
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
-        .args([
-            "run",
-            concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/slope.toml"),
-            "--out",
-        ])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        status.status.success(),
-        "{}",
-        String::from_utf8_lossy(&status.stderr)
-    );
+    let dir = run_mpm("slope.toml", "slope_scene");
     let png = std::fs::read(dir.join("final.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
     for file in [
@@ -525,21 +548,7 @@ fn features_scene_runs_with_every_remaining_key() {
     );
     let pulled: Vec<f64> = out.reports.iter().map(|r| r.reaction[0]).collect();
     assert!(pulled.windows(2).all(|w| w[1] > w[0]), "{pulled:?}");
-    let dir = common::fresh_dir("features_scene");
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
-        .args([
-            "run",
-            concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/features.toml"),
-            "--out",
-        ])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let dir = run_mpm("features.toml", "features_scene");
     let vtu = std::fs::read_to_string(dir.join("points_0002.vtu")).unwrap();
     for (name, wanted) in [
         ("displacement", true),
@@ -633,19 +642,7 @@ fn collapse_scene_equals_the_collapse_case() {
     let (problem, out) = run2(text, &[]);
     let body = collapse::geometry(&params, 0).unwrap().1;
     assert_eq!(problem.position, body.position);
-    // (Compared with `assert!`: a mismatch would print 1000 tensors.)
-    assert!(
-        out.last.sigma == case.output.last.sigma,
-        "final stresses differ"
-    );
-    assert!(
-        out.last.position == case.output.last.position,
-        "final positions differ"
-    );
-    assert!(
-        out.last.plastic_strain == case.output.last.plastic_strain,
-        "plastic strains differ"
-    );
+    assert_same_final_state(&out, &case.output);
     // Table 6 (h = 1 m, 3² points per cell): extent and height at the edge
     // of the points' initial half-spacing.
     let edge = |axis: usize| {
@@ -686,14 +683,7 @@ fn cantilever_scene_equals_the_cantilever_case() {
     assert_eq!(problem.position, body.position);
     let forces: Vec<usize> = problem.point_forces.iter().map(|(p, _)| *p).collect();
     assert_eq!(forces, loaded.to_vec());
-    assert!(
-        out.last.position == case.output.last.position,
-        "final positions differ"
-    );
-    assert!(
-        out.last.sigma == case.output.last.sigma,
-        "final stresses differ"
-    );
+    assert_same_final_state(&out, &case.output);
     let tip = cantilever::tip_displacement(&out.last, loaded);
     let (_, ux, uy) = *case.tip.last().unwrap();
     assert_eq!(tip, (ux, uy));

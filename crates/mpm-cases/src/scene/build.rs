@@ -1055,17 +1055,7 @@ impl<const D: usize> Problem<D> {
         if o.png && D != 2 {
             return Err(src.error(None, "output `png` draws 2D scenes only"));
         }
-        let fields = o.fields.clone().unwrap_or_else(|| {
-            vec![
-                Field::Displacement,
-                Field::Stress,
-                Field::DeformationGradient,
-                Field::Volume,
-                Field::PlasticStrain,
-                Field::Domain,
-                Field::Body,
-            ]
-        });
+        let fields = o.fields.clone().unwrap_or_else(|| Field::ALL.to_vec());
 
         Ok(Self {
             mesh,
