@@ -788,3 +788,44 @@ formulation = "ul"
         "{e}"
     );
 }
+
+/// A scene run stopped and resumed (two materials: the tags go through the
+/// checkpoint) writes the same results as an uninterrupted one; resuming
+/// with another scene is refused.
+#[test]
+fn scene_runs_resume_to_the_same_results() {
+    let mpm = |args: &[&str], dir: &std::path::Path| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
+            .arg("run")
+            .arg(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../scenes/two_layer_column.toml"
+            ))
+            .args(args)
+            .arg("--out")
+            .arg(dir)
+            .output()
+            .unwrap()
+    };
+    let whole = common::fresh_dir("scene_resume_whole");
+    assert!(mpm(&[], &whole).status.success());
+    let parts = common::fresh_dir("scene_resume_parts");
+    assert!(mpm(&["--stop-after", "4"], &parts).status.success());
+    let other = mpm(&["--resume", "--set", "solver.tolerance=1e-8"], &parts);
+    assert!(!other.status.success());
+    assert!(String::from_utf8_lossy(&other.stderr).contains("other parameters"));
+    assert!(mpm(&["--resume"], &parts).status.success());
+    for file in [
+        "probe_top.csv",
+        "probe_interface.csv",
+        "reaction_base.csv",
+        "steps.csv",
+        "points_0009.vtu",
+    ] {
+        assert_eq!(
+            std::fs::read(whole.join(file)).unwrap(),
+            std::fs::read(parts.join(file)).unwrap(),
+            "{file}"
+        );
+    }
+}
