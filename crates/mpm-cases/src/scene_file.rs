@@ -26,7 +26,9 @@
 //! (`material.E`); tables on the path that do not exist are created. The
 //! value is read as a TOML value if it is one (`1e6`, `true`, `[1, 2]`,
 //! `{ E = 1e6, nu = 0.3 }`, `"quoted"`) and taken as a string otherwise
-//! (`gimp`), so `basis=gimp` needs no shell-quoted quotes. Overrides are
+//! (`gimp`), so `basis=gimp` needs no shell-quoted quotes. In an array of
+//! tables (`[[material]]`) an index addresses one table:
+//! `material.1.youngs_modulus=2e7` sets the second material's modulus. Overrides are
 //! applied in order to the parsed document before it is deserialised, so
 //! the scene type's `#[serde(deny_unknown_fields)]` rejects an unknown
 //! override key just as it rejects an unknown key in the file.
@@ -178,24 +180,60 @@ impl<'a> Override<'a> {
             .split_last()
             .ok_or_else(|| self.error("empty key"))?;
         let mut table = root;
-        for (depth, &key) in parents.iter().enumerate() {
+        let mut depth = 0;
+        while depth < parents.len() {
+            let key = parents[depth];
             if !table.contains_key(key) {
                 table.insert(
                     Spanned::new(span.clone(), Cow::Borrowed(key)),
                     Spanned::new(span.clone(), DeValue::Table(DeTable::new())),
                 );
             }
+            let path = |end: usize| self.keys[..=end].join(".");
             table = match table.get_mut(key).map(Spanned::get_mut) {
                 Some(DeValue::Table(t)) => t,
+                // `key.N.rest`: inside the N-th table of an array of tables
+                // (`material.1.youngs_modulus`).
+                Some(DeValue::Array(items)) => {
+                    let count = items.len();
+                    let index = parents.get(depth + 1).and_then(|k| k.parse::<usize>().ok());
+                    let Some(index) = index else {
+                        return Err(self.error(format!(
+                            "`{}` is an array: address one of its {count} tables by index, e.g. `{}.0.{}`",
+                            path(depth),
+                            path(depth),
+                            last
+                        )));
+                    };
+                    depth += 1;
+                    match items.get_mut(index).map(Spanned::get_mut) {
+                        Some(DeValue::Table(t)) => t,
+                        Some(other) => {
+                            return Err(self.error(format!(
+                                "`{}` is {}, not a table",
+                                path(depth),
+                                article(other.type_str())
+                            )));
+                        }
+                        None => {
+                            return Err(self.error(format!(
+                                "`{}` has {count} entries (indices 0 to {}); there is no index {index}",
+                                path(depth - 1),
+                                count.saturating_sub(1)
+                            )));
+                        }
+                    }
+                }
                 Some(other) => {
                     return Err(self.error(format!(
                         "`{}` is {}, not a table",
-                        self.keys[..=depth].join("."),
+                        path(depth),
                         article(other.type_str())
                     )));
                 }
                 None => return Err(self.error("internal error: table just inserted is missing")),
             };
+            depth += 1;
         }
         match table.get_mut(*last) {
             Some(existing) => *existing = value,

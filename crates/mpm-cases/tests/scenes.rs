@@ -397,6 +397,29 @@ fn missing_sections_and_bad_overrides_are_named() {
     );
     let without_material = VALID.replacen("[[material]]", "[unused]", 1);
     assert!(refusal(&without_material).contains("unknown field `unused`"));
+    // An index addresses one table of an array of tables.
+    let (scene, _) =
+        scene::parse(VALID, "v.toml", &["material.0.youngs_modulus=3e6".into()]).unwrap();
+    assert_eq!(scene.materials[0].youngs_modulus, 3e6);
+    for (set, message) in [
+        (
+            "material.1.density=2",
+            "`material` has 1 entries (indices 0 to 0); there is no index 1",
+        ),
+        (
+            "material.density=2",
+            "`material` is an array: address one of its 1 tables by index, e.g. `material.0.density`",
+        ),
+        (
+            "material.0.name.x=2",
+            "`material.0.name` is a string, not a table",
+        ),
+    ] {
+        let e = scene::parse(VALID, "v.toml", &[set.into()])
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, format!("override `{set}`: {message}"));
+    }
     let e = scene::parse(VALID, "v.toml", &["solver.stepz=3".into()]).unwrap_err();
     assert!(
         matches!(&e, CasesError::Override { text, message } if text == "solver.stepz=3" && message.contains("unknown field `stepz`")),
