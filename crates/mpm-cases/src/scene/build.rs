@@ -1108,9 +1108,8 @@ fn grid_mesh<const D: usize>(
     variant: &Variant,
     src: &SceneSource,
 ) -> Result<(RegularGrid<D>, SVector<f64, D>, SVector<f64, D>, usize), CasesError> {
-    let origin_v = point::<D>(origin_spec, "mesh `origin`", src)?;
+    let origin = point::<D>(origin_spec, "mesh `origin`", src)?;
     let size = point::<D>(size_spec, "mesh `size`", src)?;
-    let origin = origin_v;
     if let Some(axis) = (0..D).find(|&i| size[i] <= 0.0) {
         return Err(src.at(
             size_spec,
