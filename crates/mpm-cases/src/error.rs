@@ -153,6 +153,15 @@ pub enum CasesError {
         /// What is wrong.
         message: String,
     },
+    /// The solver failed, or stopped where it was asked to.
+    #[error(transparent)]
+    Solver(#[from] mpm_solver::SolverError),
+    /// A case's default parameters cannot be written as TOML.
+    #[error("cannot write the defaults as TOML: {source}")]
+    Toml {
+        /// The serialiser's error.
+        source: toml::ser::Error,
+    },
     /// A command-line override is not of the form `key=value`.
     #[error("malformed override `{text}`: {reason} (expected key=value, e.g. material.E=1e6)")]
     MalformedOverride {

@@ -33,6 +33,7 @@ pub mod params;
 pub mod run;
 pub mod scene;
 pub mod scene_file;
+pub mod session;
 pub mod variant;
 pub mod writer;
 

@@ -167,6 +167,43 @@ crate::case_params! {
     }
 }
 
+/// The registered case (see [`crate::cases::Case`]).
+#[derive(Debug, Clone, Copy)]
+pub struct AnnulusCase;
+
+impl crate::cases::Case for AnnulusCase {
+    const NAME: &'static str = "annulus";
+    const ABOUT: &'static str = "Coombs 2020 §7.4: elastic annulus under torsion on triangles (manufactured solution, Fig. 19)";
+    type Params = AnnulusParams;
+
+    fn run(
+        mut p: AnnulusParams,
+        session: &crate::session::Session,
+    ) -> Result<(), crate::CasesError> {
+        use crate::session::summary;
+        session.resolve(&mut p.mesh);
+        let mesh = mesh(&p)?;
+        let (mut obs, control) = session.start(&p, mesh)?;
+        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+            obs.step(s, rep, snap)
+        })?;
+        let mut results = serde_json::Map::new();
+        results.insert("max_error".into(), serde_json::json!(r.max_error));
+        results.insert("elements".into(), serde_json::json!(r.elements));
+        results.insert("element_size".into(), serde_json::json!(r.element_size));
+        let s = summary(
+            Self::NAME,
+            p.variant(),
+            r.material_points,
+            &r.output,
+            Some(r.error),
+            results,
+            &p,
+        );
+        obs.finish(s)
+    }
+}
+
 /// The annulus's result.
 #[derive(Debug, Clone)]
 pub struct AnnulusResult {

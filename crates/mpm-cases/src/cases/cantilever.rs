@@ -52,6 +52,56 @@ crate::case_params! {
     }
 }
 
+/// The registered case (see [`crate::cases::Case`]).
+#[derive(Debug, Clone, Copy)]
+pub struct CantileverCase;
+
+impl crate::cases::Case for CantileverCase {
+    const NAME: &'static str = "cantilever";
+    const ABOUT: &'static str =
+        "Coombs 2020 §7.3: elastic cantilever under an end load (tip history, Newton residuals)";
+    type Params = CantileverParams;
+
+    fn run(
+        p: CantileverParams,
+        session: &crate::session::Session,
+    ) -> Result<(), crate::CasesError> {
+        use crate::session::{observer_error, summary};
+        let (grid, _, _, loaded) = geometry(&p, p.basis.padding())?;
+        let (mut obs, control) = session.start(&p, grid)?;
+        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+            // The case table first: the step's checkpoint must hold its row.
+            let (ux, uy) = tip_displacement(snap, loaded);
+            obs.writer
+                .case_row(
+                    "tip.csv",
+                    &["load_factor", "tip_u_over_l0", "tip_v_over_l0"],
+                    &[
+                        rep.lambda1.into(),
+                        (ux / p.length).into(),
+                        (uy / p.length).into(),
+                    ],
+                )
+                .map_err(observer_error)?;
+            obs.step(s, rep, snap)
+        })?;
+        let mut results = serde_json::Map::new();
+        if let Some((_, ux, uy)) = r.tip.last() {
+            results.insert("tip_displacement".into(), serde_json::json!([ux, uy]));
+        }
+        let s = summary(
+            Self::NAME,
+            p.variant(),
+            r.material_points,
+            &r.output,
+            None,
+            results,
+            &p,
+        );
+        obs.finish(s)
+    }
+}
+
 /// The cantilever's result.
 #[derive(Debug, Clone)]
 pub struct CantileverResult {

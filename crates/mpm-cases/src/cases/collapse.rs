@@ -54,6 +54,41 @@ crate::case_params! {
     }
 }
 
+/// The registered case (see [`crate::cases::Case`]).
+#[derive(Debug, Clone, Copy)]
+pub struct CollapseCase;
+
+impl crate::cases::Case for CollapseCase {
+    const NAME: &'static str = "collapse";
+    const ABOUT: &'static str = "Coombs 2020 §7.5: elasto-plastic collapse of a block (Tables 6-7)";
+    type Params = CollapseParams;
+
+    fn run(p: CollapseParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
+        use crate::session::summary;
+        let (grid, _, _) = geometry(&p, p.basis.padding())?;
+        let (mut obs, control) = session.start(&p, grid)?;
+        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+            obs.step(s, rep, snap)
+        })?;
+        let mut results = serde_json::Map::new();
+        results.insert(
+            "horizontal_extent".into(),
+            serde_json::json!(r.horizontal_extent),
+        );
+        results.insert("max_height".into(), serde_json::json!(r.max_height));
+        let s = summary(
+            Self::NAME,
+            p.variant(),
+            r.material_points,
+            &r.output,
+            None,
+            results,
+            &p,
+        );
+        obs.finish(s)
+    }
+}
+
 /// The collapse's result.
 #[derive(Debug, Clone)]
 pub struct CollapseResult {

@@ -54,6 +54,35 @@ crate::case_params! {
     }
 }
 
+/// The registered case (see [`crate::cases::Case`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ColumnCase;
+
+impl crate::cases::Case for ColumnCase {
+    const NAME: &'static str = "column";
+    const ABOUT: &'static str = "Coombs 2020 §7.1: elastic column compacting under self weight (analytic eq. 41, error eq. 42)";
+    type Params = ColumnParams;
+
+    fn run(p: ColumnParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
+        use crate::session::summary;
+        let (grid, _, _) = geometry(&p, p.basis.padding())?;
+        let (mut obs, control) = session.start(&p, grid)?;
+        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+            obs.step(s, rep, snap)
+        })?;
+        let s = summary(
+            Self::NAME,
+            p.variant(),
+            r.material_points,
+            &r.output,
+            Some(r.error),
+            serde_json::Map::new(),
+            &p,
+        );
+        obs.finish(s)
+    }
+}
+
 impl ColumnParams {
     /// The analytic vertical Cauchy stress at initial height `z` (eq. 41).
     pub fn analytic_sigma_zz(&self, z: f64) -> f64 {

@@ -1,4 +1,18 @@
-//! The benchmark cases, each with its reference solution.
+//! The benchmark cases, each with its reference solution, and their
+//! registry.
+//!
+//! A case is one module here with a type implementing [`Case`]: its name,
+//! its parameters (the scene-file keys, with defaults) and how it runs in
+//! a [`Session`] — build, solve, measure against the reference, write
+//! `summary.json`. Adding a case is that module and one line of [`ALL`];
+//! the `mpm` program lists and runs whatever [`ALL`] holds.
+
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
+use crate::CasesError;
+use crate::scene_file::parse_scene;
+use crate::session::Session;
 
 pub mod annulus;
 pub mod cantilever;
@@ -6,3 +20,75 @@ pub mod collapse;
 pub mod column;
 pub mod shear;
 pub mod stretch;
+
+/// A built-in case.
+pub trait Case {
+    /// The name `--case` and the scene key `case` use.
+    const NAME: &'static str;
+    /// One line on what it is and what it is checked against.
+    const ABOUT: &'static str;
+    /// Its parameters: every field a scene-file key with a default.
+    type Params: Serialize + DeserializeOwned + Default;
+
+    /// Runs the case with `params` in `session`, writing its outputs and
+    /// `summary.json` (its error against the reference and its results).
+    ///
+    /// # Errors
+    /// Invalid parameters, solver failures, output errors.
+    fn run(params: Self::Params, session: &Session) -> Result<(), CasesError>;
+}
+
+/// A registered case, without its types: what the `mpm` program needs.
+#[derive(Debug, Clone, Copy)]
+pub struct CaseEntry {
+    /// [`Case::NAME`].
+    pub name: &'static str,
+    /// [`Case::ABOUT`].
+    pub about: &'static str,
+    /// The default parameters, as TOML.
+    pub defaults: fn() -> Result<String, CasesError>,
+    /// Parses the scene text (`origin` names it in errors), applies the
+    /// overrides and runs.
+    pub run:
+        fn(text: &str, origin: &str, set: &[String], session: &Session) -> Result<(), CasesError>,
+}
+
+impl CaseEntry {
+    /// The entry of case `C`.
+    pub const fn of<C: Case>() -> Self {
+        Self {
+            name: C::NAME,
+            about: C::ABOUT,
+            defaults: defaults::<C>,
+            run: run::<C>,
+        }
+    }
+}
+
+fn defaults<C: Case>() -> Result<String, CasesError> {
+    toml::to_string(&C::Params::default()).map_err(|source| CasesError::Toml { source })
+}
+
+fn run<C: Case>(
+    text: &str,
+    origin: &str,
+    set: &[String],
+    session: &Session,
+) -> Result<(), CasesError> {
+    C::run(parse_scene(text, origin, set)?, session)
+}
+
+/// Every built-in case, in the order `mpm list` shows them.
+pub const ALL: [CaseEntry; 6] = [
+    CaseEntry::of::<column::ColumnCase>(),
+    CaseEntry::of::<shear::ShearCase>(),
+    CaseEntry::of::<cantilever::CantileverCase>(),
+    CaseEntry::of::<annulus::AnnulusCase>(),
+    CaseEntry::of::<collapse::CollapseCase>(),
+    CaseEntry::of::<stretch::StretchCase>(),
+];
+
+/// The registered case named `name`.
+pub fn find(name: &str) -> Option<&'static CaseEntry> {
+    ALL.iter().find(|c| c.name == name)
+}

@@ -83,6 +83,35 @@ crate::case_params! {
     }
 }
 
+/// The registered case (see [`crate::cases::Case`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ShearCase;
+
+impl crate::cases::Case for ShearCase {
+    const NAME: &'static str = "shear";
+    const ABOUT: &'static str = "Coombs 2020 §7.2: simple shear of a unit square, elastic or perfectly plastic (homogeneous)";
+    type Params = ShearParams;
+
+    fn run(p: ShearParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
+        use crate::session::summary;
+        let grid = grid(&p, p.basis.padding())?;
+        let (mut obs, control) = session.start(&p, grid)?;
+        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+            obs.step(s, rep, snap)
+        })?;
+        let s = summary(
+            Self::NAME,
+            p.variant(),
+            r.material_points,
+            &r.output,
+            Some(r.error),
+            serde_json::Map::new(),
+            &p,
+        );
+        obs.finish(s)
+    }
+}
+
 /// Prescribed shear on every node supporting a boundary point.
 #[derive(Debug, Clone)]
 struct BoundaryCellShear {

@@ -81,6 +81,49 @@ crate::case_params! {
     }
 }
 
+/// The registered case (see [`crate::cases::Case`]).
+#[derive(Debug, Clone, Copy)]
+pub struct StretchCase;
+
+impl crate::cases::Case for StretchCase {
+    const NAME: &'static str = "stretch";
+    const ABOUT: &'static str =
+        "Wang 2021 §5.3: simple stretch of a cube on tetrahedra with a moving mesh (Table 1)";
+    type Params = StretchParams;
+
+    fn run(
+        mut p: StretchParams,
+        session: &crate::session::Session,
+    ) -> Result<(), crate::CasesError> {
+        use crate::session::summary;
+        session.resolve(&mut p.mesh);
+        let mesh = mesh(&p)?;
+        let (mut obs, control) = session.start(&p, mesh)?;
+        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+            obs.step(s, rep, snap)
+        })?;
+        let mut results = serde_json::Map::new();
+        results.insert(
+            "analytic_stress".into(),
+            serde_json::json!(r.analytic_stress),
+        );
+        results.insert("tau_yy_mean".into(), serde_json::json!(r.tau_yy.0));
+        results.insert("tau_yy_min".into(), serde_json::json!(r.tau_yy.1));
+        results.insert("tau_yy_max".into(), serde_json::json!(r.tau_yy.2));
+        results.insert("elements".into(), serde_json::json!(r.elements));
+        let s = summary(
+            Self::NAME,
+            p.variant(),
+            r.material_points,
+            &r.output,
+            Some(r.error),
+            results,
+            &p,
+        );
+        obs.finish(s)
+    }
+}
+
 impl StretchParams {
     /// The analytic uniaxial Kirchhoff stress at the end (no hardening):
     /// $\min(E\ln\lambda, \sqrt{3/2}\,\varrho_y)$ with

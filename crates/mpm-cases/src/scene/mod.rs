@@ -59,11 +59,13 @@
 pub mod build;
 pub mod format;
 pub mod png;
+mod program;
 pub mod region;
 mod runner;
 
 pub use build::{Problem, SceneConstraints};
 pub use format::Scene;
+pub use program::run_file;
 pub use runner::run;
 
 use crate::CasesError;

@@ -1,0 +1,175 @@
+//! The `mpm` program's run of a whole-problem scene file.
+
+use nalgebra::SVector;
+use serde_json::{Map, Value, json};
+
+use crate::CasesError;
+use crate::output::CellMesh;
+use crate::session::{Session, observer_error, summary};
+
+/// A scene file describing a whole problem (no `case` key).
+/// Runs a scene file's text (`origin` names it in errors) with the
+/// overrides `set` in `session`: builds the problem, solves it, writes
+/// the reaction and probe histories, the VTU series, `final.png` when
+/// asked for, and `summary.json`.
+///
+/// # Errors
+/// A scene that is refused (with its location), solver and output errors.
+pub fn run_file(
+    text: &str,
+    origin: &str,
+    set: &[String],
+    session: &Session,
+) -> Result<(), CasesError> {
+    let (scene, source) = crate::scene::parse(text, origin, set)?;
+    match crate::scene::dimension(&scene, &source)? {
+        2 => scene_run_in::<2>(&scene, &source, session),
+        _ => scene_run_in::<3>(&scene, &source, session),
+    }
+}
+
+fn scene_run_in<const D: usize>(
+    scene: &crate::scene::Scene,
+    source: &crate::scene_file::SceneSource,
+    session: &Session,
+) -> Result<(), CasesError> {
+    use crate::scene::Problem;
+
+    let problem = Problem::<D>::build_in(
+        scene,
+        source,
+        scene.solver.basis.padding(),
+        &session.scene_dir,
+    )?;
+    match &problem.mesh {
+        crate::scene::build::SceneMesh::Grid(g) => {
+            scene_run_on(scene, &problem, session, g.clone())
+        }
+        crate::scene::build::SceneMesh::Simplex(m) => {
+            scene_run_on(scene, &problem, session, (**m).clone())
+        }
+    }
+}
+
+/// Runs a built scene, writing its results on the mesh `mesh`.
+fn scene_run_on<const D: usize, M: CellMesh<D>>(
+    scene: &crate::scene::Scene,
+    problem: &crate::scene::Problem<D>,
+    session: &Session,
+    mesh: M,
+) -> Result<(), CasesError> {
+    use crate::output::CsvValue;
+    use crate::writer::VtuOptions;
+
+    let (mut obs, control) = session.start(scene, mesh)?;
+    obs.writer.set_vtu_options(VtuOptions {
+        every: problem.every,
+        fields: problem.fields.clone(),
+        constants: vec![
+            (
+                "body".into(),
+                problem
+                    .body_of_point
+                    .iter()
+                    .map(|&b| f64::from(b))
+                    .collect(),
+            ),
+            (
+                "material".into(),
+                problem
+                    .material_of_point
+                    .iter()
+                    .map(|&m| f64::from(m))
+                    .collect(),
+            ),
+        ],
+    });
+    let axes = ["x", "y", "z"];
+    let reaction_header: Vec<String> = std::iter::once("load_factor".to_owned())
+        .chain(axes.iter().take(D).map(|a| format!("reaction_{a}")))
+        .collect();
+    let probe_header: Vec<String> = std::iter::once("load_factor".to_owned())
+        .chain(axes.iter().take(D).map(|a| format!("u{a}")))
+        .collect();
+    let mut last_reactions = Map::new();
+    let mut last_probes = Map::new();
+    let r = crate::scene::run(problem, &control, |s, rep, snap| {
+        let io = observer_error;
+        for (name, nodes) in &problem.reactions {
+            let total = rep
+                .node_reactions
+                .iter()
+                .filter(|(v, _)| nodes.binary_search(v).is_ok())
+                .fold(SVector::<f64, D>::zeros(), |t, (_, r)| t + r);
+            let mut row = vec![CsvValue::from(rep.lambda1)];
+            row.extend(total.iter().map(|x| CsvValue::from(*x)));
+            let header: Vec<&str> = reaction_header.iter().map(String::as_str).collect();
+            obs.writer
+                .case_row(&format!("reaction_{name}.csv"), &header, &row)
+                .map_err(io)?;
+            last_reactions.insert(name.clone(), json!(total.as_slice()));
+        }
+        for (name, p) in &problem.probes {
+            let u = &snap.displacement[*p][..D];
+            let mut row = vec![CsvValue::from(rep.lambda1)];
+            row.extend(u.iter().map(|x| CsvValue::from(*x)));
+            let header: Vec<&str> = probe_header.iter().map(String::as_str).collect();
+            obs.writer
+                .case_row(&format!("probe_{name}.csv"), &header, &row)
+                .map_err(io)?;
+            last_probes.insert(name.clone(), json!(u));
+        }
+        obs.step(s, rep, snap)
+    })?;
+    let mut results = Map::new();
+    results.insert("reactions".into(), Value::Object(last_reactions));
+    results.insert("probes".into(), Value::Object(last_probes));
+    results.insert(
+        "bodies".into(),
+        json!(
+            problem
+                .bodies
+                .iter()
+                .map(|b| json!({"name": b.name, "material_points": b.points.len()}))
+                .collect::<Vec<_>>()
+        ),
+    );
+    if problem.png {
+        let last = &r.last;
+        let plastic = last.plastic_strain.iter().any(|&e| e > 0.0);
+        let (name, value): (&str, Vec<f64>) = if plastic {
+            ("equivalent_plastic_strain", last.plastic_strain.clone())
+        } else {
+            (
+                "displacement_magnitude",
+                last.displacement
+                    .iter()
+                    .map(|u| (u[0] * u[0] + u[1] * u[1]).sqrt())
+                    .collect(),
+            )
+        };
+        let half: Vec<f64> = problem
+            .half_lengths
+            .iter()
+            .zip(&last.volume)
+            .zip(&problem.volume)
+            .map(|((l, v), v0)| l[0] * (v / v0).sqrt())
+            .collect();
+        let path = obs.writer.dir().join("final.png");
+        let (lo, hi) = crate::scene::png::write_points_png(&path, &last.position, &half, &value)?;
+        results.insert(
+            "png".into(),
+            json!({"file": "final.png", "colour": name, "blue": lo, "red": hi}),
+        );
+    }
+    let s = summary(
+        "scene",
+        problem.variant,
+        problem.len(),
+        &r,
+        None,
+        results,
+        scene,
+    );
+    obs.finish(s)
+}
