@@ -310,6 +310,7 @@ where
     O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
     let setup = analysis;
+    let moves_mesh = setup.constraints.moves_mesh();
     let mut solver: ImplicitSolver<D, Parts<B, F, L, NoLocking, U, C>> = ImplicitSolver::new(
         basis,
         setup.grid,
@@ -349,7 +350,7 @@ where
             let t = Instant::now();
             reports.push(report.clone());
             let mut snapshot = Snapshot::of(pts, report.lambda1);
-            if C::MOVES_MESH {
+            if moves_mesh {
                 snapshot.mesh_nodes = Some(
                     (0..now.mesh.node_count())
                         .map(|v| {

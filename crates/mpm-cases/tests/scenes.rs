@@ -48,7 +48,7 @@ fn run_mpm(file: &str, test: &str) -> std::path::PathBuf {
 /// The final states of a scene run and of the built-in case it mirrors are
 /// the same, bit for bit (compared with `assert!`: a mismatch would print
 /// a thousand tensors).
-fn assert_same_final_state(scene: &RunOutput<2>, case: &RunOutput<2>) {
+fn assert_same_final_state<const D: usize>(scene: &RunOutput<D>, case: &RunOutput<D>) {
     assert!(
         scene.last.position == case.last.position,
         "final positions differ"
@@ -366,6 +366,46 @@ fn malformed_scenes_are_refused_with_a_located_message() {
             "spacing = [0.75, 1.0]",
             "bad.toml:4:11: mesh `spacing` 0.75 must be positive and divide the size 2 along x",
         ),
+        (
+            "cells = [2, 2]",
+            "cells = [2, 2]\npatches = true",
+            "bad.toml:5:11: `patches` applies to kind = \"simplex\" meshes",
+        ),
+        (
+            "material = \"m\"",
+            "material = \"m\"\nplacement = \"keast11\"",
+            "bad.toml:16:13: placement = keast11 places points in tetrahedra",
+        ),
+        (
+            "[[boundary]]",
+            "[[node_set]]\nname = \"s\"\naround = \"nobody\"\n\n[[boundary]]",
+            "bad.toml:20:10: no body named `nobody`; the scene has: b",
+        ),
+        (
+            "[[boundary]]",
+            "[[node_set]]\nname = \"s\"\n\n[[boundary]]",
+            "bad.toml:19:8: node set `s` needs one of `region` or `around`",
+        ),
+        (
+            "[[boundary]]\nset = \"y_min\"\nkind = \"fixed\"",
+            "[[node_set]]\nname = \"s\"\naround = \"b\"\n\n[[boundary]]\nset = \"s\"\nkind = \"roller\"",
+            "bad.toml:23:7: a roller needs a grid face for its normal; `s` follows a body",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"displacement\"\ngradient = [[1.0]]",
+            "bad.toml:21:12: `gradient` must be 2 rows of 2 numbers in a 2D scene",
+        ),
+        (
+            "cells = [2, 2]",
+            "cells = [2, 2]\n\n[mesh.motion]\nkind = \"stretch\"\naxis = \"w\"\nextension = 1.0\ndriven = \"y_max\"",
+            "bad.toml:8:8: `axis` must be one of x, y",
+        ),
+        (
+            "[solver]",
+            "[[node_set]]\nname = \"s\"\naround = \"b\"\n\n[output]\nreaction = [{ name = \"r\", set = \"s\" }]\n\n[solver]",
+            "bad.toml:31:33: node set `s` follows a body (its nodes change every step)",
+        ),
     ];
     let mut wrong = Vec::new();
     for (from, to, expected) in cases {
@@ -599,6 +639,8 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/features.toml"),
         include_str!("../../../scenes/coombs2020_column.toml"),
         include_str!("../../../scenes/cube_gmsh.toml"),
+        include_str!("../../../scenes/coombs2020_shear.toml"),
+        include_str!("../../../scenes/wang2021_stretch.toml"),
     ]
     .join("\n");
     let mut keys = Vec::new();
@@ -636,7 +678,8 @@ fn every_documented_key_is_exercised() {
         .iter()
         .filter(|k| {
             let section = format!("[[output.{k}]]");
-            !(scenes.contains(&format!("{k} ="))
+            !((k.starts_with('[') && scenes.contains(k.as_str()))
+                || scenes.contains(&format!("{k} ="))
                 || scenes.contains(&format!("{k} = {{"))
                 || scenes.contains(&section))
         })
@@ -710,6 +753,63 @@ fn cantilever_scene_equals_the_cantilever_case() {
     let tip = cantilever::tip_displacement(&out.last, loaded);
     let (_, ux, uy) = *case.tip.last().unwrap();
     assert_eq!(tip, (ux, uy));
+}
+
+/// The built-in shear case (Coombs et al. 2020 §7.2) and its scene file:
+/// a body-following boundary (`around`) with a displacement gradient, a
+/// lattice anchored at the body on a shifted grid; the same points and the
+/// same final state bit for bit, and the homogeneous closed-form stress.
+#[test]
+fn shear_scene_equals_the_shear_case() {
+    use mpm_cases::cases::shear::{self, ShearParams};
+    let text = include_str!("../../../scenes/coombs2020_shear.toml");
+    let params = ShearParams::default();
+    let case = shear::run(
+        &params,
+        &params.variant(),
+        &RunControl::default(),
+        |_, _, _| Ok(()),
+    )
+    .unwrap();
+    let (problem, out) = run2(text, &[]);
+    assert_eq!(problem.len(), case.material_points);
+    assert_same_final_state(&out, &case.output);
+    assert_eq!(out.summary.iterations, case.output.summary.iterations);
+    // γ = 6: the closed form of the shear case's documentation.
+    let (g, mu) = (6.0f64, 10e3 / (2.0 * 1.3));
+    let a = (g / 2.0).asinh() * 2.0 * mu / (g * g + 4.0).sqrt();
+    let (s11, s12) = (a * g, a * 2.0);
+    for s in &out.last.sigma {
+        assert!((s[0] - s11).abs() < 1e-6 * s11, "σ11 {} vs {s11}", s[0]);
+        assert!((s[1] - s12).abs() < 1e-6 * s12, "σ12 {} vs {s12}", s[1]);
+    }
+}
+
+/// The built-in stretch case (Wang et al. 2021 §5.3, Table 1) and its
+/// scene file: a generated box of ten-node tetrahedra split into their
+/// children, Keast points, a stretching mesh with driven nodes; the same
+/// points and the same final state bit for bit.
+#[test]
+fn stretch_scene_equals_the_stretch_case() {
+    use mpm_cases::cases::stretch::{self, StretchParams};
+    let text = include_str!("../../../scenes/wang2021_stretch.toml");
+    let params = StretchParams::default();
+    let case = stretch::run(
+        &params,
+        &params.variant(),
+        &RunControl::default(),
+        |_, _, _| Ok(()),
+    )
+    .unwrap();
+    let (scene, src) = scene::parse(text, "wang2021_stretch.toml", &[]).unwrap();
+    let problem = Problem::<3>::build(&scene, &src, 0).unwrap();
+    let out = scene::run(&problem, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+    assert_eq!(problem.len(), case.material_points);
+    assert_same_final_state(&out, &case.output);
+    assert_eq!(out.summary.iterations, case.output.summary.iterations);
+    // The mesh moved with the face: the top nodes are at y = 4 m.
+    let top = out.last.position.iter().map(|x| x[1]).fold(0.0, f64::max);
+    assert!(top > 3.8 && top < 4.0, "highest point at y = {top}");
 }
 
 /// Gmsh meshes in scenes: the cube of tetrahedra carries its weight on its

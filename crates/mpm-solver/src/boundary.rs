@@ -12,6 +12,13 @@ pub trait Constraints<const D: usize>: Send + Sync {
     /// record its node positions every step).
     const MOVES_MESH: bool = false;
 
+    /// Whether these conditions move the mesh: [`Constraints::MOVES_MESH`]
+    /// unless the type decides at run time (a scene with or without a
+    /// mesh motion).
+    fn moves_mesh(&self) -> bool {
+        Self::MOVES_MESH
+    }
+
     /// Called at the start of every load step attempt, after the basis
     /// has been evaluated, for conditions that follow the body (e.g. every
     /// node supporting a boundary point). The default does nothing.

@@ -7,7 +7,10 @@
 use std::collections::BTreeMap;
 
 use mpm_mesh::{RegularGrid, SimplexMesh};
-use mpm_solver::{Constraints, LoadStepping, NewtonOptions};
+use mpm_solver::{
+    Constraints, LoadStepping, MeshMotionError, MovableMesh, MovingMesh, NewtonOptions, StepView,
+    Stretch,
+};
 use nalgebra::SVector;
 use toml::Spanned;
 
@@ -17,7 +20,9 @@ use crate::run::HistoryOutput;
 use crate::scene_file::SceneSource;
 use crate::variant::Variant;
 
-use super::format::{BoundaryKind, Field, LoadKind, MeshKind, RegionSpec, Scene};
+use super::format::{
+    BoundaryKind, Field, LoadKind, MeshKind, MotionKind, Placement, RegionSpec, Scene,
+};
 use super::region::{Region, point};
 
 /// Largest number of grid nodes or material points a scene may ask for
@@ -64,12 +69,54 @@ impl Curve {
 }
 
 /// Dirichlet conditions of a scene: per dof, the displacement reached
-/// where its curve is 1 and the curve.
+/// where its curve is 1 and the curve; conditions on sets that follow a
+/// body; and the mesh motion, if any.
 #[derive(Debug, Clone)]
 pub struct SceneConstraints<const D: usize> {
     /// Per mesh dof `D * node + i`: `(displacement, curve index)`.
     dofs: Vec<Option<(f64, u16)>>,
     curves: Vec<Curve>,
+    following: Vec<Following<D>>,
+    motion: Option<MovingMesh<D, Free, Stretch>>,
+}
+
+/// No conditions: what a mesh motion wraps in a scene (the scene's own
+/// conditions are checked after it).
+#[derive(Debug, Clone, Copy)]
+pub struct Free;
+
+impl<const D: usize> Constraints<D> for Free {
+    fn prescribed(&self, _: usize, _: usize, _: f64, _: f64) -> Option<f64> {
+        None
+    }
+}
+
+/// A displacement condition on the nodes supporting a body's boundary
+/// points, found again at the start of every step.
+#[derive(Debug, Clone)]
+struct Following<const D: usize> {
+    /// The boundary points.
+    points: Vec<usize>,
+    /// Initial node positions.
+    nodes: Vec<SVector<f64, D>>,
+    /// Which nodes support a boundary point this step.
+    active: Vec<bool>,
+    /// `u = d + G x` where the curve is 1.
+    displacement: SVector<f64, D>,
+    gradient: nalgebra::SMatrix<f64, D, D>,
+    curve: u16,
+}
+
+impl<const D: usize> Following<D> {
+    fn prescribed(&self, node: usize, component: usize, dc: f64) -> Option<f64> {
+        if !self.active.get(node).copied().unwrap_or(false) {
+            return None;
+        }
+        let x = self.nodes.get(node)?;
+        // (G_ij dc) x_j: the increment of a homogeneous gradient.
+        let affine = (0..D).fold(0.0, |u, j| u + self.gradient[(component, j)] * dc * x[j]);
+        Some(self.displacement[component] * dc + affine)
+    }
 }
 
 impl<const D: usize> SceneConstraints<D> {
@@ -85,8 +132,50 @@ impl<const D: usize> SceneConstraints<D> {
 }
 
 impl<const D: usize> Constraints<D> for SceneConstraints<D> {
+    const MOVES_MESH: bool = true;
+
+    fn moves_mesh(&self) -> bool {
+        self.motion.is_some()
+    }
+
+    fn begin_step(&mut self, step: &StepView<'_, D>) {
+        for f in &mut self.following {
+            f.active.iter_mut().for_each(|a| *a = false);
+            for &p in &f.points {
+                for v in step.nodes_of(p) {
+                    if let Some(a) = f.active.get_mut(v) {
+                        *a = true;
+                    }
+                }
+            }
+        }
+    }
+
+    fn move_mesh<M: MovableMesh<D>>(
+        &mut self,
+        mesh: &mut M,
+        lambda: f64,
+    ) -> Result<(), MeshMotionError> {
+        match &mut self.motion {
+            Some(m) => m.move_mesh(mesh, lambda),
+            None => Ok(()),
+        }
+    }
+
     #[inline]
     fn prescribed(&self, node: usize, component: usize, lambda0: f64, lambda1: f64) -> Option<f64> {
+        if let Some(m) = &self.motion
+            && let Some(u) = m.prescribed(node, component, lambda0, lambda1)
+        {
+            return Some(u);
+        }
+        // The last body-following condition that holds the node.
+        for f in self.following.iter().rev() {
+            let c = &self.curves[f.curve as usize];
+            if let Some(u) = f.prescribed(node, component, c.at(lambda1) - c.at(lambda0)) {
+                return Some(u);
+            }
+        }
         let (u, curve) = (*self.dofs.get(node * D + component)?)?;
         if u == 0.0 {
             return Some(0.0);
@@ -348,6 +437,9 @@ impl<const D: usize> Problem<D> {
                 if let Some(d) = m.dimension.as_ref() {
                     return Err(src.at(d, "`dimension` applies to kind = \"gmsh\" meshes (a grid's is the length of `origin`)"));
                 }
+                if let Some(p) = m.patches.as_ref() {
+                    return Err(src.at(p, "`patches` applies to kind = \"simplex\" meshes"));
+                }
                 let (Some(origin), Some(size)) = (&m.origin, &m.size) else {
                     return Err(src.error(
                         None,
@@ -372,6 +464,9 @@ impl<const D: usize> Problem<D> {
                 if let Some(span) = grid_key {
                     return Err(src.error(Some(span), "`origin`, `size`, `cells`, `spacing` and `padding` apply to kind = \"grid\" meshes"));
                 }
+                if let Some(p) = m.patches.as_ref() {
+                    return Err(src.at(p, "`patches` applies to kind = \"simplex\" meshes (quadratic Gmsh elements are always split into their linear children)"));
+                }
                 let Some(file) = &m.file else {
                     return Err(src.error(None, "[mesh]: a Gmsh mesh needs `file` and `dimension`"));
                 };
@@ -389,6 +484,38 @@ impl<const D: usize> Problem<D> {
                 };
                 let b = *simplices.bounding_box();
                 (SceneMesh::Simplex(Box::new(simplices)), b.lower, b.upper, 0)
+            }
+            MeshKind::Simplex => {
+                let misplaced = [
+                    m.file.as_ref().map(Spanned::span),
+                    m.dimension.as_ref().map(Spanned::span),
+                    m.padding.as_ref().map(Spanned::span),
+                ];
+                if let Some(span) = misplaced.into_iter().flatten().next() {
+                    return Err(src.error(Some(span), "`file`, `dimension` and `padding` do not apply to kind = \"simplex\" meshes (a box of triangles or tetrahedra needs no padding)"));
+                }
+                let (Some(origin), Some(size)) = (&m.origin, &m.size) else {
+                    return Err(src.error(
+                        None,
+                        "[mesh]: a simplex box needs `origin`, `size` and `cells` or `spacing`",
+                    ));
+                };
+                if let Err(reason) = variant.require_standard_mpm("a simplex mesh") {
+                    return Err(src.at(origin, format!("[mesh] kind = \"simplex\": {reason}")));
+                }
+                let (grid, origin_v, upper, _) = grid_mesh::<D>(m, origin, size, 0, &variant, src)?;
+                let boxed = mpm_mesh::BoxMesh::new(origin_v, upper, grid.cells_per_axis());
+                let patches = m.patches.as_ref().is_some_and(|p| *p.get_ref());
+                let simplices = if patches {
+                    boxed
+                        .quadratic_mesh()
+                        .and_then(|q| mpm_mesh::PatchMesh::from_parents(&q))
+                        .map(mpm_mesh::PatchMesh::into_mesh)
+                } else {
+                    boxed.simplex_mesh()
+                }
+                .map_err(|e| src.at(origin, format!("mesh: {e}")))?;
+                (SceneMesh::Simplex(Box::new(simplices)), origin_v, upper, 0)
             }
         };
         let size = upper - origin;
@@ -521,6 +648,18 @@ impl<const D: usize> Problem<D> {
                     let Some(region) = &region else {
                         return Err(src.error(None, "internal: a grid body without a region"));
                     };
+                    if let Some(p) = spec.placement.as_ref()
+                        && *p.get_ref() != Placement::Regular
+                    {
+                        return Err(src.at(
+                            p,
+                            "placement = keast11 places points in tetrahedra; a body on a grid has placement = regular",
+                        ));
+                    }
+                    let anchor = match &spec.lattice_origin {
+                        Some(a) => Some(point::<D>(a, "`lattice_origin`", src)?),
+                        None => None,
+                    };
                     problem_points
                         .fill(
                             grid,
@@ -528,6 +667,7 @@ impl<const D: usize> Problem<D> {
                             cells,
                             region,
                             ppc,
+                            anchor,
                             src,
                             &spec.points_per_cell,
                         )?
@@ -560,7 +700,30 @@ impl<const D: usize> Problem<D> {
                             .collect(),
                         (_, None) => Vec::new(),
                     };
-                    let per_element = ppc.checked_pow(D as u32).unwrap_or(usize::MAX);
+                    if let Some(a) = &spec.lattice_origin {
+                        return Err(src.at(
+                            a,
+                            "`lattice_origin` applies to bodies on a grid (simplex bodies fill their elements)",
+                        ));
+                    }
+                    let rule = match spec.placement.as_ref() {
+                        Some(p) if *p.get_ref() == Placement::Keast11 => {
+                            if D != 3 {
+                                return Err(src.at(
+                                    p,
+                                    "placement = keast11 is a rule for tetrahedra (3D meshes)",
+                                ));
+                            }
+                            crate::body::SimplexRule::Keast11
+                        }
+                        _ => crate::body::SimplexRule::Subdivision(ppc),
+                    };
+                    let per_element = match rule {
+                        crate::body::SimplexRule::Keast11 => 11,
+                        crate::body::SimplexRule::Subdivision(_) => {
+                            ppc.checked_pow(D as u32).unwrap_or(usize::MAX)
+                        }
+                    };
                     if elements
                         .len()
                         .saturating_mul(per_element)
@@ -587,11 +750,7 @@ impl<const D: usize> Problem<D> {
                         }
                         element_owner[e] = Some(b);
                     }
-                    let body = crate::body::Body::fill_simplices(
-                        sm,
-                        &elements,
-                        crate::body::SimplexRule::Subdivision(ppc),
-                    );
+                    let body = crate::body::Body::fill_simplices(sm, &elements, rule);
                     problem_points.position.extend_from_slice(&body.position);
                     problem_points.volume.extend_from_slice(&body.volume);
                     problem_points
@@ -680,8 +839,12 @@ impl<const D: usize> Problem<D> {
                     .or_insert_with(|| nodes.to_vec());
             }
         }
+        // Sets that follow a body: its boundary points.
+        let mut following_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
         for spec in &scene.node_sets {
-            if sets.contains_key(spec.name.get_ref()) {
+            if sets.contains_key(spec.name.get_ref())
+                || following_sets.contains_key(spec.name.get_ref())
+            {
                 return Err(src.at(
                     &spec.name,
                     format!(
@@ -690,7 +853,43 @@ impl<const D: usize> Problem<D> {
                     ),
                 ));
             }
-            let region = Region::<D>::new(&spec.region, src)?;
+            let region_spec = match (&spec.region, &spec.around) {
+                (Some(r), None) => r,
+                (None, Some(body_name)) => {
+                    let k = lookup(&body_names, body_name, "body", src)?;
+                    let body = &bodies[k];
+                    let (Some(region), false) = (&regions[k], body.step.is_empty()) else {
+                        return Err(src.at(
+                            body_name,
+                            "`around` needs a body given by a region on a grid (its boundary points are those with a lattice neighbour outside the region)",
+                        ));
+                    };
+                    let boundary: Vec<usize> = body
+                        .points
+                        .clone()
+                        .filter(|&p| {
+                            let x = problem_points.position[p];
+                            (0..D).any(|i| {
+                                let mut e = SVector::<f64, D>::zeros();
+                                e[i] = body.step[i];
+                                !region.contains(&(x + e)) || !region.contains(&(x - e))
+                            })
+                        })
+                        .collect();
+                    following_sets.insert(spec.name.get_ref().clone(), boundary);
+                    continue;
+                }
+                _ => {
+                    return Err(src.at(
+                        &spec.name,
+                        format!(
+                            "node set `{}` needs one of `region` or `around`",
+                            spec.name.get_ref()
+                        ),
+                    ));
+                }
+            };
+            let region = Region::<D>::new(region_spec, src)?;
             let nodes: Vec<usize> = (0..mesh.node_count())
                 .filter(|&v| region.contains(&node_position(v)))
                 .collect();
@@ -703,6 +902,15 @@ impl<const D: usize> Problem<D> {
             sets.insert(spec.name.get_ref().clone(), nodes);
         }
         let set_of = |name: &Spanned<String>| -> Result<&Vec<usize>, CasesError> {
+            if following_sets.contains_key(name.get_ref()) {
+                return Err(src.at(
+                    name,
+                    format!(
+                        "node set `{}` follows a body (its nodes change every step); use it for a fixed or displacement boundary",
+                        name.get_ref()
+                    ),
+                ));
+            }
             sets.get(name.get_ref()).ok_or_else(|| {
                 src.at(
                     name,
@@ -717,7 +925,68 @@ impl<const D: usize> Problem<D> {
 
         // Boundaries (later conditions replace earlier ones on shared dofs).
         let mut dofs: Vec<Option<(f64, u16)>> = vec![None; mesh.node_count() * D];
+        let mut following = Vec::new();
+        let initial_nodes: Vec<SVector<f64, D>> =
+            (0..mesh.node_count()).map(node_position).collect();
         for spec in &scene.boundaries {
+            let gradient = match &spec.gradient {
+                Some(g) => Some(gradient_of::<D>(g, src)?),
+                None => None,
+            };
+            if let Some(points) = following_sets.get(spec.set.get_ref()) {
+                let (displacement, gradient, curve) = match spec.kind.get_ref() {
+                    BoundaryKind::Fixed => {
+                        if spec.displacement.is_some()
+                            || spec.gradient.is_some()
+                            || spec.curve.is_some()
+                        {
+                            return Err(src.at(&spec.kind, "`displacement`, `gradient` and `curve` apply to kind = displacement, not fixed"));
+                        }
+                        (SVector::zeros(), nalgebra::SMatrix::<f64, D, D>::zeros(), 0)
+                    }
+                    BoundaryKind::Displacement => {
+                        let d = match &spec.displacement {
+                            Some(d) => displacement_of::<D>(d, src)?,
+                            None if gradient.is_some() => [None; 3],
+                            None => {
+                                return Err(src.at(&spec.kind, "kind = displacement needs `displacement = { x = …, y = … }` or `gradient`"));
+                            }
+                        };
+                        if gradient.is_none() && d.iter().take(D).any(Option::is_none) {
+                            return Err(src.at(&spec.set, "a displacement on a set that follows a body prescribes every component: give all of them, or a `gradient`"));
+                        }
+                        (
+                            SVector::<f64, D>::from_fn(|i, _| d[i].unwrap_or(0.0)),
+                            gradient.unwrap_or_else(nalgebra::SMatrix::<f64, D, D>::zeros),
+                            curve_of(&spec.curve)?,
+                        )
+                    }
+                    BoundaryKind::Roller => {
+                        return Err(src.at(
+                            &spec.set,
+                            format!(
+                                "a roller needs a grid face for its normal; `{}` follows a body",
+                                spec.set.get_ref()
+                            ),
+                        ));
+                    }
+                    BoundaryKind::Velocity => {
+                        return Err(src.at(
+                            &spec.kind,
+                            "kind = velocity needs the explicit solver; the implicit solver prescribes displacements (kind = displacement)",
+                        ));
+                    }
+                };
+                following.push(Following {
+                    points: points.clone(),
+                    nodes: initial_nodes.clone(),
+                    active: vec![false; mesh.node_count()],
+                    displacement,
+                    gradient,
+                    curve: curve as u16,
+                });
+                continue;
+            }
             let nodes = set_of(&spec.set)?;
             let mut prescribe = |component: usize, value: f64, curve: usize| {
                 for &v in nodes {
@@ -743,6 +1012,9 @@ impl<const D: usize> Problem<D> {
                     if spec.curve.is_some() {
                         return Err(not_here("curve", kind));
                     }
+                    if spec.gradient.is_some() {
+                        return Err(not_here("gradient", kind));
+                    }
                     if *spec.kind.get_ref() == BoundaryKind::Fixed {
                         (0..D).for_each(|i| prescribe(i, 0.0, 0));
                     } else {
@@ -763,25 +1035,35 @@ impl<const D: usize> Problem<D> {
                     }
                 }
                 BoundaryKind::Displacement => {
-                    let Some(d) = &spec.displacement else {
-                        return Err(src.at(
-                            &spec.kind,
-                            "kind = displacement needs `displacement = { x = …, y = … }`",
-                        ));
-                    };
                     let curve = curve_of(&spec.curve)?;
-                    let values = d.get_ref().get();
-                    if let Some(axis) = (D..3).find(|&i| values[i].is_some()) {
-                        return Err(
-                            src.at(d, format!("a {D}D scene has no {} component", AXES[axis]))
-                        );
-                    }
-                    if values.iter().all(Option::is_none) {
-                        return Err(src.at(d, "`displacement` needs at least one of x, y, z"));
-                    }
-                    for (i, v) in values.iter().take(D).enumerate() {
-                        if let Some(v) = v {
-                            prescribe(i, *v, curve);
+                    let values = match (&spec.displacement, &gradient) {
+                        (Some(d), _) => displacement_of::<D>(d, src)?,
+                        (None, Some(_)) => [None; 3],
+                        (None, None) => {
+                            return Err(src.at(
+                                &spec.kind,
+                                "kind = displacement needs `displacement = { x = …, y = … }` or `gradient`",
+                            ));
+                        }
+                    };
+                    match &gradient {
+                        None => {
+                            for (i, v) in values.iter().take(D).enumerate() {
+                                if let Some(v) = v {
+                                    prescribe(i, *v, curve);
+                                }
+                            }
+                        }
+                        Some(g) => {
+                            // Every component: u = d + G x at the node.
+                            for &v in nodes {
+                                let x = initial_nodes[v];
+                                for i in 0..D {
+                                    let u = values[i].unwrap_or(0.0)
+                                        + (0..D).map(|j| g[(i, j)] * x[j]).sum::<f64>();
+                                    dofs[v * D + i] = Some((u, curve as u16));
+                                }
+                            }
                         }
                     }
                 }
@@ -793,9 +1075,15 @@ impl<const D: usize> Problem<D> {
                 }
             }
         }
+        let motion = match &m.motion {
+            Some(spec) => Some(motion_of(spec, &sets, &initial_nodes, origin, upper, src)?),
+            None => None,
+        };
         let constraints = SceneConstraints {
             dofs,
             curves: curves.clone(),
+            following,
+            motion,
         };
 
         // Loads.
@@ -1076,6 +1364,7 @@ impl<const D: usize> Problem<D> {
             newton: NewtonOptions {
                 tolerance,
                 max_iterations,
+                predictor: s.predictor,
                 ..NewtonOptions::default()
             },
             variant,
@@ -1195,6 +1484,121 @@ fn grid_mesh<const D: usize>(
     Ok((grid, origin, upper, padding))
 }
 
+/// The components of a `displacement` table, checked against the
+/// dimension (at least one given).
+fn displacement_of<const D: usize>(
+    d: &Spanned<super::format::Axes>,
+    src: &SceneSource,
+) -> Result<[Option<f64>; 3], CasesError> {
+    let values = d.get_ref().get();
+    if let Some(axis) = (D..3).find(|&i| values[i].is_some()) {
+        return Err(src.at(d, format!("a {D}D scene has no {} component", AXES[axis])));
+    }
+    if values.iter().all(Option::is_none) {
+        return Err(src.at(d, "`displacement` needs at least one of x, y, z"));
+    }
+    if let Some(v) = values.iter().flatten().find(|v| !v.is_finite()) {
+        return Err(src.at(d, format!("`displacement` must be finite, got {v}")));
+    }
+    Ok(values)
+}
+
+/// A `gradient`: `D` rows of `D` finite numbers.
+fn gradient_of<const D: usize>(
+    g: &Spanned<Vec<Vec<f64>>>,
+    src: &SceneSource,
+) -> Result<nalgebra::SMatrix<f64, D, D>, CasesError> {
+    let rows = g.get_ref();
+    if rows.len() != D || rows.iter().any(|r| r.len() != D) {
+        return Err(src.at(
+            g,
+            format!("`gradient` must be {D} rows of {D} numbers in a {D}D scene"),
+        ));
+    }
+    if rows.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(src.at(g, "`gradient` must be finite"));
+    }
+    Ok(nalgebra::SMatrix::<f64, D, D>::from_fn(|i, j| rows[i][j]))
+}
+
+/// The mesh motion of `[mesh.motion]`.
+fn motion_of<const D: usize>(
+    spec: &super::format::MotionSpec,
+    sets: &BTreeMap<String, Vec<usize>>,
+    initial: &[SVector<f64, D>],
+    lower: SVector<f64, D>,
+    upper: SVector<f64, D>,
+    src: &SceneSource,
+) -> Result<MovingMesh<D, Free, Stretch>, CasesError> {
+    let axis_of = |name: &str| AXES.iter().take(D).position(|a| *a == name);
+    let Some(axis) = axis_of(spec.axis.get_ref()) else {
+        return Err(src.at(
+            &spec.axis,
+            format!("`axis` must be one of {}", AXES[..D].join(", ")),
+        ));
+    };
+    let MotionKind::Stretch = spec.kind.get_ref();
+    let origin = spec.origin.unwrap_or(lower[axis]);
+    let length = match &spec.length {
+        Some(l) => *l.get_ref(),
+        None => upper[axis] - origin,
+    };
+    if !(length > 0.0 && length.is_finite() && origin.is_finite()) {
+        let at = spec.length.as_ref().map_or(&spec.axis, |_| &spec.axis);
+        return Err(src.at(
+            at,
+            format!("a stretch needs a finite positive length from `origin`, got {length}"),
+        ));
+    }
+    if !spec.extension.is_finite() || length + spec.extension <= 0.0 {
+        return Err(src.at(
+            &spec.kind,
+            format!(
+                "`extension` {} must be finite and leave a positive length",
+                spec.extension
+            ),
+        ));
+    }
+    let driven = sets.get(spec.driven.get_ref()).ok_or_else(|| {
+        src.at(
+            &spec.driven,
+            format!(
+                "no node set named `{}`; the scene has: {}",
+                spec.driven.get_ref(),
+                sets.keys().cloned().collect::<Vec<_>>().join(", ")
+            ),
+        )
+    })?;
+    let mut components = [false; D];
+    match &spec.components {
+        None => components[axis] = true,
+        Some(list) => {
+            for name in list.get_ref() {
+                let Some(i) = axis_of(name) else {
+                    return Err(src.at(
+                        list,
+                        format!("`components` must name axes among {}", AXES[..D].join(", ")),
+                    ));
+                };
+                components[i] = true;
+            }
+        }
+    }
+    let motion = Stretch {
+        axis,
+        origin,
+        length,
+        extension: spec.extension,
+    };
+    Ok(MovingMesh::new(
+        Free,
+        motion,
+        initial.to_vec(),
+        driven,
+        components,
+    ))
+}
+
 /// Point arrays while the bodies are filled.
 #[derive(Default)]
 struct Points<const D: usize> {
@@ -1217,22 +1621,33 @@ impl<const D: usize> Points<D> {
         cells: [usize; D],
         region: &Region<D>,
         ppc: usize,
+        anchor: Option<SVector<f64, D>>,
         src: &SceneSource,
         ppc_span: &Spanned<usize>,
     ) -> Result<SVector<f64, D>, CasesError> {
         let h = *grid.spacing();
         let step = h / ppc as f64;
-        let origin = grid.origin() + h * padding as f64;
+        // The lattice: sub-cells of the unpadded grid, or anchored at the
+        // body's own `lattice_origin` (then the region, which lies in the
+        // mesh, bounds it).
+        let origin = anchor.unwrap_or_else(|| grid.origin() + h * padding as f64);
         // Only the lattice over the region's bounding box is visited.
         let (lo, hi) = region.bounds();
-        let mut first = [0usize; D];
+        let mut first = [0i64; D];
         let mut count = [0usize; D];
         for i in 0..D {
-            let per_axis = cells[i].saturating_mul(ppc);
-            let a = ((lo[i] - origin[i]) / step[i]).floor().max(0.0) as usize;
-            let b = (((hi[i] - origin[i]) / step[i]).ceil().max(0.0) as usize).min(per_axis);
-            first[i] = a.min(per_axis);
-            count[i] = b.saturating_sub(first[i]);
+            let a = ((lo[i] - origin[i]) / step[i]).floor();
+            let b = ((hi[i] - origin[i]) / step[i]).ceil();
+            if anchor.is_some() {
+                first[i] = a as i64;
+                count[i] = (b - a).max(0.0) as usize;
+            } else {
+                let per_axis = cells[i].saturating_mul(ppc);
+                let a = (a.max(0.0) as usize).min(per_axis);
+                let b = (b.max(0.0) as usize).min(per_axis);
+                first[i] = a as i64;
+                count[i] = b.saturating_sub(a);
+            }
         }
         let total = count.iter().try_fold(1usize, |n, &c| n.checked_mul(c));
         if total.is_none_or(|t| t.saturating_add(self.position.len()) > MAX_ENTITIES) {
@@ -1246,7 +1661,7 @@ impl<const D: usize> Points<D> {
             let mut rest = flat;
             let mut x = SVector::<f64, D>::zeros();
             for i in 0..D {
-                let k = first[i] + rest % count[i];
+                let k = first[i] + (rest % count[i]) as i64;
                 rest /= count[i];
                 x[i] = origin[i] + (k as f64 + 0.5) * step[i];
             }

@@ -58,6 +58,10 @@ pub enum MeshKind {
     /// A Gmsh MSH 4.1 file of triangles or tetrahedra (linear, or
     /// quadratic split into their linear children).
     Gmsh,
+    /// The box `origin .. origin + size` of `cells` squares or cubes, each
+    /// split into triangles or tetrahedra (or into six-node triangles or
+    /// ten-node tetrahedra split into their linear children, `patches`).
+    Simplex,
 }
 
 /// `[mesh]`: a regular grid over the box `origin .. origin + size`, or a
@@ -90,6 +94,51 @@ pub struct MeshSpec {
     /// Gmsh: the dimension (2 or 3).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dimension: Option<Spanned<usize>>,
+    /// Simplex boxes: each simplex is a quadratic parent split into its
+    /// 4 (2D) or 8 (3D) linear children, the patches of F-patch (default
+    /// false: linear simplices).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub patches: Option<Spanned<bool>>,
+    /// The mesh moves with the load factor (moving-mesh conditions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<MotionSpec>,
+}
+
+/// Kinds of mesh motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MotionKind {
+    /// Uniform stretch along one axis: $x_a = o + (X_a - o)(L_0 +
+    /// \lambda\,\Delta L)/L_0$, the other coordinates fixed.
+    Stretch,
+}
+
+/// `[mesh.motion]`: the background mesh follows the load factor, and the
+/// nodes of the `driven` set have their `components` prescribed to move
+/// with it (Beuth 2012; Wang et al. 2021 §2.2).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MotionSpec {
+    /// The motion.
+    pub kind: Spanned<MotionKind>,
+    /// `stretch`: the stretched axis (`x`, `y` or `z`).
+    pub axis: Spanned<String>,
+    /// `stretch`: coordinate of the plane that stays (default: the mesh's
+    /// lower bound along the axis).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<f64>,
+    /// `stretch`: initial length $L_0$ (default: the mesh's extent along
+    /// the axis).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length: Option<Spanned<f64>>,
+    /// `stretch`: extension $\Delta L$ at load factor 1 (m).
+    pub extension: f64,
+    /// Node set whose nodes move with the mesh.
+    pub driven: Spanned<String>,
+    /// Components of the driven nodes that are prescribed (default: the
+    /// axis).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub components: Option<Spanned<Vec<String>>>,
 }
 
 /// `[[material]]`.
@@ -159,20 +208,48 @@ pub struct BodySpec {
     /// sub-simplices, one point at each centroid.
     #[serde(default = "default_points_per_cell")]
     pub points_per_cell: Spanned<usize>,
+    /// How the points are placed: `regular` (the lattice or the
+    /// sub-simplices of `points_per_cell`, the default) or `keast11`
+    /// (Keast's 11-point rule in every tetrahedron).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub placement: Option<Spanned<Placement>>,
+    /// Grids: a point the lattice of points is anchored at (the lower
+    /// corner of a sub-cell), instead of the grid's origin — for a body
+    /// that is not aligned with the grid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lattice_origin: Option<Spanned<Vec<f64>>>,
+}
+
+/// Placement of a body's points.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Placement {
+    /// Sub-cell centres of a lattice (grids) or sub-simplex centroids.
+    #[default]
+    Regular,
+    /// Keast's 11 points per tetrahedron, equal volumes (3D simplex meshes).
+    Keast11,
 }
 
 fn default_points_per_cell() -> Spanned<usize> {
     Spanned::new(0..0, 2)
 }
 
-/// `[[node_set]]`: the grid nodes in a region, by name.
+/// `[[node_set]]`: the mesh nodes in a region, or the nodes that support
+/// a body's boundary points, by name.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct NodeSetSpec {
     /// Name the boundaries and outputs use.
     pub name: Spanned<String>,
     /// The nodes inside it (boundary included) form the set.
-    pub region: RegionSpec,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<RegionSpec>,
+    /// The nodes whose basis stencil reaches a boundary point of this body
+    /// (a grid body's points with a lattice neighbour outside its region),
+    /// found again at the start of every load step as the body moves.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub around: Option<Spanned<String>>,
 }
 
 /// Kinds of Dirichlet condition.
@@ -223,6 +300,13 @@ pub struct BoundarySpec {
     /// For `displacement`: the displacement reached where the curve is 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub displacement: Option<Spanned<Axes>>,
+    /// For `displacement`: a displacement gradient $\mathbf G$ (rows of
+    /// $D$ numbers), so that node $v$ at initial position $\mathbf x_v$
+    /// reaches $\mathbf u = \mathbf d + \mathbf G\,\mathbf x_v$ where the
+    /// curve is 1 ($\mathbf d$: `displacement`, zero if absent); every
+    /// component is then prescribed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gradient: Option<Spanned<Vec<Vec<f64>>>>,
     /// For `displacement`: the load curve (default: linear in the load
     /// factor).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -326,6 +410,10 @@ pub struct SolverSpec {
     pub tolerance: Spanned<f64>,
     /// Newton iteration limit per step.
     pub max_iterations: Spanned<usize>,
+    /// Start each step from the previous step's increment (a secant
+    /// predictor; keeps Newton on the branch of the previous step where
+    /// perfectly plastic equilibrium paths bifurcate).
+    pub predictor: bool,
 }
 
 impl Default for SolverSpec {
@@ -344,6 +432,7 @@ impl Default for SolverSpec {
             min_increment: None,
             tolerance: Spanned::new(0..0, 1e-9),
             max_iterations: Spanned::new(0..0, newton.max_iterations),
+            predictor: newton.predictor,
         }
     }
 }

@@ -83,7 +83,8 @@ pub fn parse(
     parse_scene_located(text, origin, overrides)
 }
 
-/// The dimension of a scene: the length of its grid origin, or the
+/// The dimension of a scene: the length of its grid (or simplex box)
+/// origin, or the
 /// `dimension` of its Gmsh mesh, if 2 or 3.
 ///
 /// # Errors
@@ -92,12 +93,14 @@ pub fn parse(
 pub fn dimension(scene: &Scene, source: &SceneSource) -> Result<usize, CasesError> {
     let m = &scene.mesh;
     let (d, at) = match (m.kind, &m.origin, &m.dimension) {
-        (format::MeshKind::Grid, Some(origin), _) => (origin.get_ref().len(), origin.span()),
+        (format::MeshKind::Grid | format::MeshKind::Simplex, Some(origin), _) => {
+            (origin.get_ref().len(), origin.span())
+        }
         (format::MeshKind::Gmsh, _, Some(d)) => (*d.get_ref(), d.span()),
-        (format::MeshKind::Grid, None, _) => {
+        (format::MeshKind::Grid | format::MeshKind::Simplex, None, _) => {
             return Err(source.error(
                 None,
-                "[mesh]: a grid needs `origin`, `size` and `cells` or `spacing`",
+                "[mesh]: a grid or simplex box needs `origin`, `size` and `cells` or `spacing`",
             ));
         }
         (format::MeshKind::Gmsh, _, None) => {
