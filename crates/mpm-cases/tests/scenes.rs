@@ -367,6 +367,16 @@ fn malformed_scenes_are_refused_with_a_located_message() {
             "bad.toml:4:11: mesh `spacing` 0.75 must be positive and divide the size 2 along x",
         ),
         (
+            "kind = \"gravity\"\nacceleration = [0.0, -10.0]",
+            "kind = \"manufactured\"\nfield = \"vortex\"",
+            "bad.toml:24:9: unknown manufactured field `vortex`; the fields are: annulus_torsion",
+        ),
+        (
+            "kind = \"gravity\"\nacceleration = [0.0, -10.0]",
+            "kind = \"manufactured\"\nfield = \"annulus_torsion\"\nparameters = { inner_radius = 0.75, outer = 1.25, alpha = 0.1 }",
+            "bad.toml:25:14: field `annulus_torsion` has no parameter `outer`; it takes inner_radius, outer_radius, alpha",
+        ),
+        (
             "cells = [2, 2]",
             "cells = [2, 2]\npatches = true",
             "bad.toml:5:11: `patches` applies to kind = \"simplex\" meshes",
@@ -641,6 +651,7 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/cube_gmsh.toml"),
         include_str!("../../../scenes/coombs2020_shear.toml"),
         include_str!("../../../scenes/wang2021_stretch.toml"),
+        include_str!("../../../scenes/coombs2020_annulus.toml"),
     ]
     .join("\n");
     let mut keys = Vec::new();
@@ -810,6 +821,49 @@ fn stretch_scene_equals_the_stretch_case() {
     // The mesh moved with the face: the top nodes are at y = 4 m.
     let top = out.last.position.iter().map(|x| x[1]).fold(0.0, f64::max);
     assert!(top > 3.8 && top < 4.0, "highest point at y = {top}");
+}
+
+/// The built-in annulus case (Coombs et al. 2020 §7.4) on the Gmsh mesh of
+/// `scenes/annulus_gmsh.toml` and its scene file with the manufactured
+/// body force as a named field: the same points and final state bit for
+/// bit, so the same error against the exact rotation field.
+#[test]
+fn annulus_scene_equals_the_annulus_case() {
+    use mpm_cases::cases::annulus::{self, AnnulusParams};
+    let scenes = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes"));
+    let params = AnnulusParams {
+        mesh: Some(scenes.join("meshes/annulus_2.msh")),
+        ..AnnulusParams::default()
+    };
+    let case = annulus::run(
+        &params,
+        &params.variant(),
+        &RunControl::default(),
+        |_, _, _| Ok(()),
+    )
+    .unwrap();
+    let text = include_str!("../../../scenes/coombs2020_annulus.toml");
+    let (scene, src) = scene::parse(text, "coombs2020_annulus.toml", &[]).unwrap();
+    let problem = Problem::<2>::build_in(&scene, &src, 0, scenes).unwrap();
+    let out = scene::run(&problem, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+    assert_eq!(problem.len(), case.material_points);
+    assert_same_final_state(&out, &case.output);
+    assert_eq!(out.summary.iterations, case.output.summary.iterations);
+    // The scene's displacements against the exact field of eq. (44) give
+    // the case's error (measured: 3.8e-3 m).
+    let torsion = annulus::Torsion {
+        inner_radius: 0.75,
+        outer_radius: 1.25,
+        mu: 0.5,
+    };
+    let mut sum = 0.0;
+    for (p, u) in out.last.displacement.iter().enumerate() {
+        let x0 = nalgebra::Vector2::new(problem.position[p][0], problem.position[p][1]);
+        let exact = torsion.displacement(0.1, &x0);
+        sum += (nalgebra::Vector2::new(u[0], u[1]) - exact).norm() * problem.volume[p];
+    }
+    let error = sum / problem.volume.iter().sum::<f64>();
+    assert_eq!(error, case.error);
 }
 
 /// Gmsh meshes in scenes: the cube of tetrahedra carries its weight on its

@@ -8,8 +8,8 @@ use std::collections::BTreeMap;
 
 use mpm_mesh::{RegularGrid, SimplexMesh};
 use mpm_solver::{
-    Constraints, LoadStepping, MeshMotionError, MovableMesh, MovingMesh, NewtonOptions, StepView,
-    Stretch,
+    BodyForcePath, Constraints, LoadStepping, MeshMotionError, MovableMesh, MovingMesh,
+    NewtonOptions, StepView, Stretch,
 };
 use nalgebra::SVector;
 use toml::Spanned;
@@ -284,6 +284,8 @@ pub struct Problem<const D: usize> {
     pub point_forces: Vec<(usize, SVector<f64, D>)>,
     /// Forces following load curves.
     pub curved: Vec<CurvedForces<D>>,
+    /// Manufactured body forces: force on point `p` at load factor λ.
+    pub manufactured: Vec<BodyForcePath<D>>,
     /// Load stepping.
     pub stepping: LoadStepping,
     /// Newton controls.
@@ -1090,6 +1092,7 @@ impl<const D: usize> Problem<D> {
         let mut body_force: Vec<SVector<f64, D>> = Vec::new();
         let mut point_forces = Vec::new();
         let mut curved: BTreeMap<usize, Vec<SVector<f64, D>>> = BTreeMap::new();
+        let mut manufactured = Vec::new();
         let nearest = |x: &SVector<f64, D>| -> usize {
             (0..n)
                 .min_by(|&a, &b| {
@@ -1111,7 +1114,7 @@ impl<const D: usize> Problem<D> {
                 )
             };
             // Keys that belong to other kinds.
-            let present: [(&str, bool, LoadKind); 6] = [
+            let present: [(&str, bool, LoadKind); 8] = [
                 (
                     "acceleration",
                     spec.acceleration.is_some(),
@@ -1122,6 +1125,12 @@ impl<const D: usize> Problem<D> {
                 ("region", spec.region.is_some(), LoadKind::Point),
                 ("traction", spec.traction.is_some(), LoadKind::Traction),
                 ("side", spec.side.is_some(), LoadKind::Traction),
+                ("field", spec.field.is_some(), LoadKind::Manufactured),
+                (
+                    "parameters",
+                    spec.parameters.is_some(),
+                    LoadKind::Manufactured,
+                ),
             ];
             for (key, given, owner) in present {
                 if given && owner != kind {
@@ -1129,6 +1138,7 @@ impl<const D: usize> Problem<D> {
                         LoadKind::Gravity => "gravity",
                         LoadKind::Point => "point",
                         LoadKind::Traction => "traction",
+                        LoadKind::Manufactured => "manufactured",
                     };
                     return Err(refuse(key, name));
                 }
@@ -1141,6 +1151,30 @@ impl<const D: usize> Problem<D> {
                 forces[p] += f;
             };
             match kind {
+                LoadKind::Manufactured => {
+                    let range = match &spec.body {
+                        Some(b) => bodies[lookup(&body_names, b, "body", src)?].points.clone(),
+                        None => 0..n,
+                    };
+                    let shear_modulus: Vec<f64> = problem_points
+                        .material
+                        .iter()
+                        .map(|&m| {
+                            let p = &materials[m as usize].params;
+                            p.youngs_modulus / (2.0 * (1.0 + p.poisson_ratio))
+                        })
+                        .collect();
+                    manufactured.push(manufactured_force::<D>(
+                        spec,
+                        range,
+                        &problem_points.position,
+                        &problem_points.volume,
+                        shear_modulus,
+                        curves[curve].clone(),
+                        src,
+                    )?);
+                    continue;
+                }
                 LoadKind::Gravity => {
                     let Some(a) = &spec.acceleration else {
                         return Err(src.at(&spec.kind, "a gravity load needs `acceleration`"));
@@ -1360,6 +1394,7 @@ impl<const D: usize> Problem<D> {
             body_force,
             point_forces,
             curved,
+            manufactured,
             stepping: LoadStepping { initial, max, min },
             newton: NewtonOptions {
                 tolerance,
@@ -1482,6 +1517,103 @@ fn grid_mesh<const D: usize>(
         .map_err(|e| src.at(origin_spec, format!("mesh: {e}")))?;
     let upper = origin + size;
     Ok((grid, origin, upper, padding))
+}
+
+/// The manufactured fields `kind = "manufactured"` loads can name, with
+/// their parameters.
+pub const MANUFACTURED_FIELDS: [(&str, &[&str]); 1] = [(
+    "annulus_torsion",
+    &["inner_radius", "outer_radius", "alpha"],
+)];
+
+/// The body force of a `manufactured` load on the points `range` (the
+/// other points get none), per point at load factor λ: the field's force
+/// per unit volume at amplitude `curve(λ)` times the point's volume.
+#[allow(clippy::too_many_arguments)]
+fn manufactured_force<const D: usize>(
+    spec: &super::format::LoadSpec,
+    range: std::ops::Range<usize>,
+    position: &[SVector<f64, D>],
+    volume: &[f64],
+    shear_modulus: Vec<f64>,
+    curve: Curve,
+    src: &SceneSource,
+) -> Result<BodyForcePath<D>, CasesError> {
+    use std::sync::Arc;
+    let Some(field) = &spec.field else {
+        return Err(src.at(
+            &spec.kind,
+            format!(
+                "a manufactured load needs `field` (one of {})",
+                MANUFACTURED_FIELDS.map(|f| f.0).join(", ")
+            ),
+        ));
+    };
+    let Some((name, keys)) = MANUFACTURED_FIELDS
+        .iter()
+        .find(|(name, _)| name == field.get_ref())
+    else {
+        return Err(src.at(
+            field,
+            format!(
+                "unknown manufactured field `{}`; the fields are: {}",
+                field.get_ref(),
+                MANUFACTURED_FIELDS.map(|f| f.0).join(", ")
+            ),
+        ));
+    };
+    let empty = Spanned::new(field.span(), BTreeMap::new());
+    let given = spec.parameters.as_ref().unwrap_or(&empty);
+    if let Some(k) = given.get_ref().keys().find(|k| !keys.contains(&k.as_str())) {
+        return Err(src.at(
+            given,
+            format!(
+                "field `{name}` has no parameter `{k}`; it takes {}",
+                keys.join(", ")
+            ),
+        ));
+    }
+    let value = |key: &str| -> Result<f64, CasesError> {
+        match given.get_ref().get(key) {
+            Some(v) if v.is_finite() => Ok(*v),
+            Some(v) => Err(src.at(given, format!("`{key}` must be finite, got {v}"))),
+            None => Err(src.at(
+                given,
+                format!(
+                    "field `{name}` needs `parameters = {{ {} }}`",
+                    keys.join(", ")
+                ),
+            )),
+        }
+    };
+    if D != 2 {
+        return Err(src.at(field, format!("field `{name}` is a 2D field")));
+    }
+    let (inner, outer, alpha) = (value(keys[0])?, value(keys[1])?, value(keys[2])?);
+    if !(0.0 < inner && inner < outer) {
+        return Err(src.at(
+            given,
+            format!("`inner_radius` {inner} and `outer_radius` {outer} need 0 < inner < outer"),
+        ));
+    }
+    // Coombs et al. 2020 §7.4, eq. (44): see `cases::annulus`.
+    let x0: Vec<nalgebra::Vector2<f64>> = position
+        .iter()
+        .map(|x| nalgebra::Vector2::new(x[0], x[1]))
+        .collect();
+    let v0 = volume.to_vec();
+    Ok(BodyForcePath(Arc::new(move |q: usize, lambda: f64| {
+        if !range.contains(&q) {
+            return SVector::zeros();
+        }
+        let torsion = crate::cases::annulus::Torsion {
+            inner_radius: inner,
+            outer_radius: outer,
+            mu: shear_modulus[q],
+        };
+        let b = torsion.body_force(curve.at(lambda) * alpha, &x0[q]) * v0[q];
+        SVector::<f64, D>::from_fn(|i, _| if i < 2 { b[i] } else { 0.0 })
+    })))
 }
 
 /// The components of a `displacement` table, checked against the

@@ -325,6 +325,9 @@ pub enum LoadKind {
     /// A traction on one side of a body, shared by its points on that side
     /// by their face areas.
     Traction,
+    /// The body force of a manufactured solution: the force that makes a
+    /// named displacement field exact (method of manufactured solutions).
+    Manufactured,
 }
 
 /// `[[load]]`.
@@ -351,6 +354,12 @@ pub struct LoadSpec {
     /// `traction`: the side of the body (`x_min` … `z_max`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub side: Option<Spanned<String>>,
+    /// `manufactured`: the field (`annulus_torsion`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub field: Option<Spanned<String>>,
+    /// `manufactured`: the field's parameters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parameters: Option<Spanned<std::collections::BTreeMap<String, f64>>>,
     /// `gravity` (optional) and `traction` (required): the body loaded.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub body: Option<Spanned<String>>,

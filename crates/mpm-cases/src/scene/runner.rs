@@ -165,12 +165,14 @@ where
         }
         points.body_force.clone_from(&p.body_force);
         points.point_force.clone_from(&p.point_forces);
-        if !p.curved.is_empty() {
+        if !p.curved.is_empty() || !p.manufactured.is_empty() {
             let curved = Arc::new(p.curved.clone());
+            let manufactured = p.manufactured.clone();
             points.body_force_path = Some(BodyForcePath(Arc::new(move |point, lambda| {
-                curved.iter().fold(SVector::<f64, D>::zeros(), |f, c| {
+                let f = curved.iter().fold(SVector::<f64, D>::zeros(), |f, c| {
                     f + c.force[point] * c.curve.at(lambda)
-                })
+                });
+                manufactured.iter().fold(f, |f, m| f + (m.0)(point, lambda))
             })));
         }
         let analysis = Analysis {
