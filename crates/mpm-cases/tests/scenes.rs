@@ -590,8 +590,8 @@ fn column_scene_equals_the_column_case() {
         ];
         let set: Vec<&str> = set.iter().map(String::as_str).collect();
         let (problem, out) = run2(text, &set);
-        let body = column::geometry(&params, basis.padding()).unwrap().1;
-        assert_eq!(problem.position, body.position, "{basis}");
+        let built = column::problem(&params, &params.variant()).unwrap();
+        assert_eq!(problem.position, built.position, "{basis}");
         assert_eq!(
             out.last.sigma, case.output.last.sigma,
             "{basis} {update} {formulation}"

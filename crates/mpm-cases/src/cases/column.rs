@@ -8,21 +8,12 @@
 //! $Z$ the initial height) and the error norm (eq. 42)
 //! $\sum_p |\sigma_{zz,p} - \sigma^a_{zz}(Z_p)| V^0_p / (\varrho_0 g l_0 V_0)$.
 
-use std::marker::PhantomData;
+use mpm_solver::SolverError;
 
-use mpm_constitutive::LogStrainLaw;
-use mpm_mesh::RegularGrid;
-use mpm_solver::{
-    DomainUpdater, Flat, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
-};
-use nalgebra::SVector;
-
-use crate::body::{Body, InitialDomain};
-use crate::material::{LawVisitor, MaterialModel, MaterialParams, dispatch_law};
-use crate::run::{
-    DomainBounds, HistoryOutput, Loads, RunControl, RunOutput, Setup, Snapshot, simulate,
-};
-use crate::variant::{Variant, VariantVisitor, dispatch};
+use crate::material::MaterialModel;
+use crate::run::{RunControl, RunOutput, Snapshot};
+use crate::scene::Problem;
+use crate::variant::Variant;
 
 crate::case_params! {
     /// Parameters of the column case (defaults: the paper's values).
@@ -65,9 +56,12 @@ impl crate::cases::Case for ColumnCase {
 
     fn run(p: ColumnParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
         use crate::session::summary;
-        let (grid, _, _) = geometry(&p, p.basis.padding())?;
-        let (mut obs, control) = session.start(&p, grid)?;
-        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+        let problem = problem(&p, &p.variant())?;
+        let crate::scene::build::SceneMesh::Grid(grid) = &problem.mesh else {
+            return Err(SolverError::InvalidInput("the column runs on a grid".into()).into());
+        };
+        let (mut obs, control) = session.start(&p, grid.clone())?;
+        let r = run_problem(&p, &problem, &control, |s, rep, snap| {
             obs.step(s, rep, snap)
         })?;
         let s = summary(
@@ -115,13 +109,16 @@ pub struct ColumnResult {
     pub material_points: usize,
 }
 
-/// The grid and body of the column: the grid spans the column exactly
-/// (one cell wide); a basis that needs padding (B-spline) gets that many
-/// cells on every side; nodes below the base are held like the base.
-pub fn geometry(
-    p: &ColumnParams,
-    pad: usize,
-) -> Result<(RegularGrid<2>, Body<2>, NodalConstraints<2>), SolverError> {
+/// The column as a scene (the text of `scenes/coombs2020_column.toml`
+/// with the parameters and variant filled in): a grid one cell wide that
+/// spans the column exactly, with the padding the basis needs; every node
+/// held horizontally (both faces of the one-cell grid, padding included),
+/// the base and the padding below it held vertically; gravity on the
+/// column's weight.
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] when `h` does not divide the height.
+pub fn scene_text(p: &ColumnParams, variant: &Variant) -> Result<String, SolverError> {
     let cells_y = (p.height / p.h).round() as usize;
     if cells_y == 0 || (cells_y as f64 * p.h - p.height).abs() > 1e-9 * p.height {
         return Err(SolverError::InvalidInput(format!(
@@ -129,132 +126,66 @@ pub fn geometry(
             p.h, p.height
         )));
     }
-    let padf = pad as f64 * p.h;
-    let grid = RegularGrid::new(
-        SVector::<f64, 2>::new(-padf, -padf),
-        SVector::<f64, 2>::new(p.h, p.h),
-        [1 + 2 * pad, cells_y + 2 * pad],
-    )
-    .map_err(SolverError::from)?;
-    let body = Body::fill_box(
-        &grid,
-        &SVector::<f64, 2>::zeros(),
-        &SVector::<f64, 2>::new(p.h, p.height),
-        p.points_per_cell,
-    );
-    let mut constraints = NodalConstraints::<2>::new(grid.node_count());
-    // Sides: every node fixed horizontally (the column is one cell wide).
-    constraints.fix(0..grid.node_count(), 0);
-    // Base (and the padding layer below it) fixed vertically.
-    let base: Vec<usize> = (0..grid.node_count())
-        .filter(|&n| {
-            grid.node_position(n)
-                .map(|x| x[1] <= 1e-9 * p.h)
-                .unwrap_or(false)
-        })
-        .collect();
-    constraints.fix(base, 1);
-    Ok((grid, body, constraints))
+    let plastic = match p.yield_stress {
+        Some(y) => format!("yield_stress = {y:?}\nhardening = {:?}\n", p.hardening),
+        None => String::new(),
+    };
+    Ok(format!(
+        "[mesh]\norigin = [0.0, 0.0]\nsize = [{h:?}, {height:?}]\ncells = [1, {cells_y}]\n\n\
+         [[material]]\nname = \"column\"\nmodel = \"{model}\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = {rho:?}\n{plastic}\n\
+         [[body]]\nname = \"column\"\nmaterial = \"column\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [{h:?}, {height:?}] }} }}\npoints_per_cell = {ppc}\n\n\
+         [[boundary]]\nset = \"x_min\"\nkind = \"roller\"\n\n\
+         [[boundary]]\nset = \"x_max\"\nkind = \"roller\"\n\n\
+         [[boundary]]\nset = \"y_min\"\nkind = \"roller\"\n\n\
+         [[load]]\nkind = \"gravity\"\nacceleration = [0.0, {g:?}]\n\n{solver}",
+        h = p.h,
+        height = p.height,
+        model = p.material,
+        e = p.youngs_modulus,
+        nu = p.poisson_ratio,
+        rho = p.density,
+        ppc = p.points_per_cell,
+        g = -p.gravity,
+        solver = super::solver_section(variant, p.load_steps, p.tolerance),
+    ))
 }
 
-struct ColumnRun<'a, O> {
-    params: &'a ColumnParams,
-    control: &'a RunControl,
+/// The column's scene, built.
+///
+/// # Errors
+/// As [`scene_text`], and the scene's own checks.
+pub fn problem(p: &ColumnParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
+    super::build_scene(&scene_text(p, variant)?, "column", variant.basis.padding())
+}
+
+/// Runs the built column and measures it against eq. (42).
+///
+/// # Errors
+/// Whatever the run returns.
+pub fn run_problem<O>(
+    p: &ColumnParams,
+    problem: &Problem<2>,
+    control: &RunControl,
     observer: O,
-}
-
-impl<O> VariantVisitor<2> for ColumnRun<'_, O>
+) -> Result<ColumnResult, SolverError>
 where
     O: FnMut(usize, &mpm_solver::StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    type Output = Result<ColumnResult, SolverError>;
-
-    fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
-    where
-        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
-        F: Formulation,
-        U: DomainUpdater<2, B::Domain>,
-    {
-        let p = self.params;
-        let material = MaterialParams {
-            youngs_modulus: p.youngs_modulus,
-            poisson_ratio: p.poisson_ratio,
-            yield_stress: p.yield_stress,
-            hardening: p.hardening,
-        };
-        dispatch_law(
-            p.material,
-            &material,
-            WithLaw::<B, F, U, O> {
-                run: self,
-                basis,
-                updater,
-                formulation: PhantomData,
-            },
-        )?
-    }
+    let output = crate::scene::run(problem, control, observer)?;
+    let z0: Vec<f64> = problem.position.iter().map(|x| x[1]).collect();
+    let error = p.error(&output.last, &z0, &problem.volume);
+    Ok(ColumnResult {
+        output,
+        error,
+        material_points: problem.len(),
+    })
 }
 
-/// The column with basis `B`, formulation `F`, updater `U` and the law
-/// the scene names.
-struct WithLaw<'a, B, F, U, O> {
-    run: ColumnRun<'a, O>,
-    basis: B,
-    updater: U,
-    formulation: PhantomData<F>,
-}
-
-impl<B, F, U, O> LawVisitor for WithLaw<'_, B, F, U, O>
-where
-    B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
-    F: Formulation,
-    U: DomainUpdater<2, B::Domain>,
-    O: FnMut(usize, &mpm_solver::StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    type Output = Result<ColumnResult, SolverError>;
-
-    fn visit<L>(self, law: L) -> Self::Output
-    where
-        L: LogStrainLaw,
-        L::History: HistoryOutput + Flat,
-    {
-        let (p, basis, updater) = (self.run.params, self.basis, self.updater);
-        let (grid, body, constraints) = geometry(p, B::PADDING)?;
-        let setup = Setup {
-            grid,
-            body: &body,
-            density: p.density,
-            law,
-            loads: Loads {
-                gravity: Some(SVector::<f64, 2>::new(0.0, -p.gravity)),
-                point_forces: Vec::new(),
-                body_force_path: None,
-            },
-            constraints,
-            stepping: LoadStepping::uniform(p.load_steps),
-            newton: NewtonOptions {
-                tolerance: p.tolerance,
-                ..NewtonOptions::default()
-            },
-        };
-        let output = simulate::<2, B, F, U, _, _, _>(
-            setup,
-            basis,
-            updater,
-            self.run.control,
-            self.run.observer,
-        )?;
-        let z0: Vec<f64> = body.position.iter().map(|x| x[1]).collect();
-        let error = p.error(&output.last, &z0, &body.volume);
-        Ok(ColumnResult {
-            output,
-            error,
-            material_points: body.len(),
-        })
-    }
-}
-
-/// Runs the column with `variant`.
+/// Runs the column with `variant`: its scene ([`scene_text`]), built and
+/// run, measured against eq. (42).
+///
+/// # Errors
+/// As [`problem`] and [`run_problem`].
 pub fn run<O>(
     params: &ColumnParams,
     variant: &Variant,
@@ -264,13 +195,5 @@ pub fn run<O>(
 where
     O: FnMut(usize, &mpm_solver::StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    dispatch(
-        variant,
-        ColumnRun {
-            params,
-            control,
-            observer,
-        },
-    )
-    .map_err(SolverError::InvalidInput)?
+    run_problem(params, &problem(params, variant)?, control, observer)
 }

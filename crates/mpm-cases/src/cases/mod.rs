@@ -92,3 +92,36 @@ pub const ALL: [CaseEntry; 6] = [
 pub fn find(name: &str) -> Option<&'static CaseEntry> {
     ALL.iter().find(|c| c.name == name)
 }
+
+/// The `[solver]` section of a case's scene: the variant, the number of
+/// equal steps and the Newton tolerance.
+pub(crate) fn solver_section(
+    variant: &crate::variant::Variant,
+    steps: usize,
+    tolerance: f64,
+) -> String {
+    format!(
+        "[solver]\nbasis = \"{}\"\nformulation = \"{}\"\nlocking = \"{}\"\ndomain_update = \"{}\"\ngimp_volume = \"{}\"\nsteps = {steps}\ntolerance = {tolerance:?}\n",
+        variant.basis,
+        variant.formulation,
+        variant.locking,
+        variant.domain_update,
+        variant.gimp_volume
+    )
+}
+
+/// Builds the scene a case wrote as `text` (named `case` in errors): a
+/// case's parameters that make no valid scene are refused with the
+/// scene's message.
+pub(crate) fn build_scene<const D: usize>(
+    text: &str,
+    case: &str,
+    padding: usize,
+) -> Result<crate::scene::Problem<D>, mpm_solver::SolverError> {
+    let invalid =
+        |e: CasesError| mpm_solver::SolverError::InvalidInput(format!("case {case}: {e}"));
+    let (scene, src) =
+        crate::scene::parse(text, &format!("the {case} case's scene"), &[]).map_err(invalid)?;
+    crate::scene::Problem::<D>::build_in(&scene, &src, padding, std::path::Path::new(""))
+        .map_err(invalid)
+}
