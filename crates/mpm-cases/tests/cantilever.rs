@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used)]
 
 use mpm_basis::LinearMpm;
-use mpm_cases::cases::cantilever::{CantileverParams, geometry, run};
+use mpm_cases::cases::cantilever::{CantileverParams, problem, run};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{FormulationKind, Variant};
 use mpm_constitutive::HenckyElastic;
@@ -97,13 +97,18 @@ fn the_pc_solution_satisfies_ul_equilibrium_at_every_step() {
         points_per_cell: 2,
         ..CantileverParams::default()
     };
-    let (grid, body, constraints, loaded) = geometry(&p, 0).unwrap();
+    // The case's own scene: its grid, points, conditions and loaded points.
+    let (built, loaded) = problem(&p, &p.variant()).unwrap();
+    let mpm_cases::scene::build::SceneMesh::Grid(grid) = built.mesh.clone() else {
+        panic!("the cantilever runs on a grid")
+    };
+    let constraints = built.constraints.clone();
     let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio).unwrap();
     let mut points: MaterialPoints<2, (), ()> = MaterialPoints::new(
-        body.position.clone(),
-        body.volume.clone(),
+        built.position.clone(),
+        built.volume.clone(),
         0.0,
-        vec![(); body.len()],
+        vec![(); built.len()],
     )
     .unwrap();
     let force = SVector::<f64, 2>::new(0.0, -p.load / 2.0);

@@ -378,6 +378,11 @@ fn malformed_scenes_are_refused_with_a_located_message() {
         ),
         (
             "cells = [2, 2]",
+            "cells = [2, 2]\nlayers = 3",
+            "bad.toml:5:10: `inner_radius`, `outer_radius`, `layers`, `ring_nodes`, `jitter` and `seed` apply to kind = \"annulus\" meshes",
+        ),
+        (
+            "cells = [2, 2]",
             "cells = [2, 2]\npatches = true",
             "bad.toml:5:11: `patches` applies to kind = \"simplex\" meshes",
         ),
@@ -717,8 +722,8 @@ fn collapse_scene_equals_the_collapse_case() {
     )
     .unwrap();
     let (problem, out) = run2(text, &[]);
-    let body = collapse::geometry(&params, 0).unwrap().1;
-    assert_eq!(problem.position, body.position);
+    let built = collapse::problem(&params, &params.variant()).unwrap();
+    assert_eq!(problem.position, built.position);
     assert_same_final_state(&out, &case.output);
     // Table 6 (h = 1 m, 3² points per cell): extent and height at the edge
     // of the points' initial half-spacing.
@@ -756,8 +761,8 @@ fn cantilever_scene_equals_the_cantilever_case() {
     )
     .unwrap();
     let (problem, out) = run2(text, &[]);
-    let (_, body, _, loaded) = cantilever::geometry(&params, 0).unwrap();
-    assert_eq!(problem.position, body.position);
+    let (built, loaded) = cantilever::problem(&params, &params.variant()).unwrap();
+    assert_eq!(problem.position, built.position);
     let forces: Vec<usize> = problem.point_forces.iter().map(|(p, _)| *p).collect();
     assert_eq!(forces, loaded.to_vec());
     assert_same_final_state(&out, &case.output);
@@ -823,18 +828,16 @@ fn stretch_scene_equals_the_stretch_case() {
     assert!(top > 3.8 && top < 4.0, "highest point at y = {top}");
 }
 
-/// The built-in annulus case (Coombs et al. 2020 §7.4) on the Gmsh mesh of
-/// `scenes/annulus_gmsh.toml` and its scene file with the manufactured
-/// body force as a named field: the same points and final state bit for
-/// bit, so the same error against the exact rotation field.
+/// The built-in annulus case (Coombs et al. 2020 §7.4) at its defaults and
+/// its scene file (a generated annulus, the manufactured body force as a
+/// named field): the same points and final state bit for bit, so the same
+/// error against the exact rotation field; and the case on the Gmsh mesh
+/// of `scenes/annulus_gmsh.toml` is that scene with the Gmsh mesh.
 #[test]
 fn annulus_scene_equals_the_annulus_case() {
     use mpm_cases::cases::annulus::{self, AnnulusParams};
     let scenes = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes"));
-    let params = AnnulusParams {
-        mesh: Some(scenes.join("meshes/annulus_2.msh")),
-        ..AnnulusParams::default()
-    };
+    let params = AnnulusParams::default();
     let case = annulus::run(
         &params,
         &params.variant(),
@@ -864,6 +867,23 @@ fn annulus_scene_equals_the_annulus_case() {
     }
     let error = sum / problem.volume.iter().sum::<f64>();
     assert_eq!(error, case.error);
+    // The same scene on the committed Gmsh annulus is the case on it.
+    let gmsh = AnnulusParams {
+        mesh: Some(scenes.join("meshes/annulus_2.msh")),
+        ..AnnulusParams::default()
+    };
+    let on_gmsh = annulus::run(&gmsh, &gmsh.variant(), &RunControl::default(), |_, _, _| {
+        Ok(())
+    })
+    .unwrap();
+    let gmsh_text = text.replace(
+        "kind = \"annulus\"\ninner_radius = 0.75\nouter_radius = 1.25\nlayers = 4\nring_nodes = 63\njitter = 0.0\nseed = 1",
+        "kind = \"gmsh\"\nfile = \"meshes/annulus_2.msh\"\ndimension = 2",
+    );
+    let (scene, src) = scene::parse(&gmsh_text, "annulus_gmsh", &[]).unwrap();
+    let problem = Problem::<2>::build_in(&scene, &src, 0, scenes).unwrap();
+    let out = scene::run(&problem, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+    assert_same_final_state(&out, &on_gmsh.output);
 }
 
 /// Gmsh meshes in scenes: the cube of tetrahedra carries its weight on its

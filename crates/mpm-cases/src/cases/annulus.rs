@@ -52,21 +52,14 @@
 //! the constitutive update computes from $\mathbf F$.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
-use mpm_basis::LinearSimplex;
-use mpm_constitutive::HenckyElastic;
-use mpm_mesh::{AnnulusMesh, GmshElements, SimplexMesh, read_msh};
-use mpm_solver::{
-    BodyForcePath, Formulation, LoadStepping, NewtonOptions, NodalConstraints, PreviouslyConverged,
-    SolverError, StepReport, UpdatedLagrangian,
-};
+use mpm_solver::{SolverError, StepReport};
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
-use crate::body::{Body, SimplexRule};
-use crate::run::{Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
-use crate::variant::{FormulationKind, Variant};
+use crate::run::{RunControl, RunOutput, Snapshot};
+use crate::scene::Problem;
+use crate::variant::Variant;
 
 /// The rotation field of eq. (44) and its manufactured body force.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -182,9 +175,12 @@ impl crate::cases::Case for AnnulusCase {
     ) -> Result<(), crate::CasesError> {
         use crate::session::summary;
         session.resolve(&mut p.mesh);
-        let mesh = mesh(&p)?;
-        let (mut obs, control) = session.start(&p, mesh)?;
-        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+        let problem = problem(&p, &p.variant())?;
+        let crate::scene::build::SceneMesh::Simplex(mesh) = &problem.mesh else {
+            return Err(SolverError::InvalidInput("the annulus runs on triangles".into()).into());
+        };
+        let (mut obs, control) = session.start(&p, (**mesh).clone())?;
+        let r = run_problem(&p, &problem, &control, |s, rep, snap| {
             obs.step(s, rep, snap)
         })?;
         let mut results = serde_json::Map::new();
@@ -222,36 +218,73 @@ pub struct AnnulusResult {
     pub element_size: f64,
 }
 
-/// The background mesh: generated, or read from `p.mesh`.
-pub fn mesh(p: &AnnulusParams) -> Result<SimplexMesh<2>, SolverError> {
-    let invalid = SolverError::from;
-    if let Some(path) = &p.mesh {
-        return match read_msh::<2>(path).map_err(invalid)?.elements {
-            GmshElements::Linear(mesh) => Ok(mesh),
-            GmshElements::Quadratic(_) => Err(SolverError::InvalidInput(format!(
-                "{}: the annulus needs linear triangles (tri3)",
-                path.display()
-            ))),
-        };
-    }
-    if !(p.h > 0.0 && p.h.is_finite()) {
-        return Err(SolverError::InvalidInput(format!(
-            "h = {} must be positive",
-            p.h
-        )));
-    }
-    let radial = ((p.outer_radius - p.inner_radius) / p.h).ceil().max(2.0) as usize;
-    let ring = (2.0 * std::f64::consts::PI * p.outer_radius / p.h)
-        .round()
-        .max(8.0) as usize;
-    AnnulusMesh::new(p.inner_radius, p.outer_radius, radial, ring)
-        .with_jitter(p.jitter, 1)
-        .simplex_mesh()
-        .map_err(invalid)
+/// The annulus as a scene (the text of `scenes/coombs2020_annulus.toml`
+/// with the parameters filled in): the generated annulus mesh of element
+/// size about `h` (round((R_o − R_i)/h) layers, at least 2, and
+/// round(2π R_o/h) nodes per ring, at least 8), or the Gmsh file `mesh`
+/// (linear triangles with physical groups `inner`, `outer` and `domain`);
+/// both rims fixed; the manufactured body force of eq. (44).
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] for a non-positive `h` or a variant other
+/// than standard MPM.
+pub fn scene_text(p: &AnnulusParams, variant: &Variant) -> Result<String, SolverError> {
+    variant
+        .require_standard_mpm("triangles")
+        .map_err(SolverError::InvalidInput)?;
+    let mesh = match &p.mesh {
+        Some(path) => format!(
+            "kind = \"gmsh\"\nfile = {}\ndimension = 2\n",
+            toml::Value::String(path.display().to_string())
+        ),
+        None => {
+            if !(p.h > 0.0 && p.h.is_finite()) {
+                return Err(SolverError::InvalidInput(format!(
+                    "h = {} must be positive",
+                    p.h
+                )));
+            }
+            let radial = ((p.outer_radius - p.inner_radius) / p.h).ceil().max(2.0) as usize;
+            let ring = (2.0 * std::f64::consts::PI * p.outer_radius / p.h)
+                .round()
+                .max(8.0) as usize;
+            format!(
+                "kind = \"annulus\"\ninner_radius = {:?}\nouter_radius = {:?}\nlayers = {radial}\nring_nodes = {ring}\njitter = {:?}\nseed = 1\n",
+                p.inner_radius, p.outer_radius, p.jitter
+            )
+        }
+    };
+    Ok(format!(
+        "[mesh]\n{mesh}\n\
+         [[material]]\nname = \"annulus\"\nmodel = \"hencky\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\n\n\
+         [[body]]\nname = \"annulus\"\nmaterial = \"annulus\"\nregion = {{ group = \"domain\" }}\npoints_per_cell = {ppe}\n\n\
+         [[boundary]]\nset = \"inner\"\nkind = \"fixed\"\n\n\
+         [[boundary]]\nset = \"outer\"\nkind = \"fixed\"\n\n\
+         [[load]]\nkind = \"manufactured\"\nfield = \"annulus_torsion\"\nparameters = {{ inner_radius = {ri:?}, outer_radius = {ro:?}, alpha = {alpha:?} }}\n\n{solver}",
+        e = p.youngs_modulus,
+        nu = p.poisson_ratio,
+        ppe = p.points_per_element,
+        ri = p.inner_radius,
+        ro = p.outer_radius,
+        alpha = p.alpha,
+        solver = super::solver_section(variant, p.load_steps, p.tolerance),
+    ))
+}
+
+/// The annulus's scene, built.
+///
+/// # Errors
+/// As [`scene_text`], and the scene's own checks.
+pub fn problem(p: &AnnulusParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
+    super::build_scene(&scene_text(p, variant)?, "annulus", 0)
 }
 
 /// Runs the annulus with `variant` (standard MPM on the triangles; UL or
-/// PC).
+/// PC): its scene ([`scene_text`]), built and run, measured against the
+/// exact displacement.
+///
+/// # Errors
+/// As [`problem`] and [`run_problem`].
 pub fn run<O>(
     p: &AnnulusParams,
     variant: &Variant,
@@ -261,79 +294,37 @@ pub fn run<O>(
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    variant
-        .require_standard_mpm("triangles")
-        .map_err(SolverError::InvalidInput)?;
-    match variant.formulation {
-        FormulationKind::Pc => go::<PreviouslyConverged, _>(p, control, observer),
-        FormulationKind::Ul => go::<UpdatedLagrangian, _>(p, control, observer),
-    }
+    run_problem(p, &problem(p, variant)?, control, observer)
 }
 
-fn go<F: Formulation, O>(
+/// Runs the built annulus and measures the displacement error.
+///
+/// # Errors
+/// Whatever the run returns.
+pub fn run_problem<O>(
     p: &AnnulusParams,
+    problem: &Problem<2>,
     control: &RunControl,
     observer: O,
 ) -> Result<AnnulusResult, SolverError>
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    let mesh = mesh(p)?;
-    let all: Vec<usize> = (0..mesh.element_count()).collect();
-    let body = Body::fill_simplices(&mesh, &all, SimplexRule::Subdivision(p.points_per_element));
-    let mut constraints = NodalConstraints::<2>::new(mesh.node_count());
-    for rim in ["inner", "outer"] {
-        let nodes = mesh.node_sets().get(rim).ok_or_else(|| {
-            SolverError::InvalidInput(format!("the mesh has no node set `{rim}` for the rims"))
-        })?;
-        constraints.fix(nodes.iter().copied(), 0);
-        constraints.fix(nodes.iter().copied(), 1);
-    }
-    let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio).map_err(SolverError::from)?;
+    let output = crate::scene::run(problem, control, observer)?;
+    let (elements, area) = match &problem.mesh {
+        crate::scene::build::SceneMesh::Simplex(m) => (m.element_count(), m.total_volume()),
+        crate::scene::build::SceneMesh::Grid(_) => (0, 0.0),
+    };
     let torsion = Torsion {
         inner_radius: p.inner_radius,
         outer_radius: p.outer_radius,
         mu: p.youngs_modulus / (2.0 * (1.0 + p.poisson_ratio)),
     };
-    let (x0, v0) = (
-        Arc::new(body.position.clone()),
-        Arc::new(body.volume.clone()),
-    );
-    let alpha = p.alpha;
-    let force = {
-        let (x0, v0) = (Arc::clone(&x0), Arc::clone(&v0));
-        BodyForcePath(Arc::new(move |q: usize, lambda: f64| {
-            torsion.body_force(lambda * alpha, &x0[q]) * v0[q]
-        }))
-    };
-    let (elements, area) = (mesh.element_count(), mesh.total_volume());
-    let setup = Setup {
-        grid: mesh,
-        body: &body,
-        density: 0.0,
-        law,
-        loads: Loads {
-            gravity: None,
-            point_forces: Vec::new(),
-            body_force_path: Some(force),
-        },
-        constraints,
-        stepping: LoadStepping::uniform(p.load_steps),
-        newton: NewtonOptions {
-            tolerance: p.tolerance,
-            ..NewtonOptions::default()
-        },
-    };
-    let output = simulate::<2, LinearSimplex, F, mpm_solver::NoUpdate, _, _, _>(
-        setup,
-        LinearSimplex,
-        mpm_solver::NoUpdate,
-        control,
-        observer,
-    )?;
+    let v0 = &problem.volume;
     let (mut sum, mut max) = (0.0f64, 0.0f64);
     for (q, u) in output.last.displacement.iter().enumerate() {
-        let exact = torsion.displacement(alpha, &x0[q]);
+        let x0 = Vector2::new(problem.position[q][0], problem.position[q][1]);
+        let exact = torsion.displacement(p.alpha, &x0);
         let e = (Vector2::new(u[0], u[1]) - exact).norm();
         sum += e * v0[q];
         max = max.max(e);
@@ -341,9 +332,9 @@ where
     Ok(AnnulusResult {
         error: sum / v0.iter().sum::<f64>(),
         max_error: max,
-        material_points: body.len(),
+        material_points: problem.len(),
         elements,
-        element_size: (2.0 * area / elements as f64).sqrt(),
+        element_size: (2.0 * area / elements.max(1) as f64).sqrt(),
         output,
     })
 }

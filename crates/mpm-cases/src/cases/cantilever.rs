@@ -9,17 +9,11 @@
 //! and the Newton residuals of every step (Table 3 shows their asymptotic
 //! quadratic convergence).
 
-use mpm_constitutive::HenckyElastic;
-use mpm_mesh::RegularGrid;
-use mpm_solver::{
-    DomainUpdater, Flat, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
-    StepReport,
-};
-use nalgebra::SVector;
+use mpm_solver::{SolverError, StepReport};
 
-use crate::body::{Body, InitialDomain};
-use crate::run::{DomainBounds, Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
-use crate::variant::{Variant, VariantVisitor, dispatch};
+use crate::run::{RunControl, RunOutput, Snapshot};
+use crate::scene::Problem;
+use crate::variant::Variant;
 
 crate::case_params! {
     /// Parameters of the cantilever case (defaults: the paper's values).
@@ -67,9 +61,12 @@ impl crate::cases::Case for CantileverCase {
         session: &crate::session::Session,
     ) -> Result<(), crate::CasesError> {
         use crate::session::{observer_error, summary};
-        let (grid, _, _, loaded) = geometry(&p, p.basis.padding())?;
-        let (mut obs, control) = session.start(&p, grid)?;
-        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+        let (problem, loaded) = problem(&p, &p.variant())?;
+        let crate::scene::build::SceneMesh::Grid(grid) = &problem.mesh else {
+            return Err(SolverError::InvalidInput("the cantilever runs on a grid".into()).into());
+        };
+        let (mut obs, control) = session.start(&p, grid.clone())?;
+        let r = run_problem(&problem, loaded, &control, |s, rep, snap| {
             // The case table first: the step's checkpoint must hold its row.
             let (ux, uy) = tip_displacement(snap, loaded);
             obs.writer
@@ -113,11 +110,19 @@ pub struct CantileverResult {
     pub material_points: usize,
 }
 
-/// Grid, body, root constraints and the indices of the two loaded points.
-pub fn geometry(
-    p: &CantileverParams,
-    pad: usize,
-) -> Result<(RegularGrid<2>, Body<2>, NodalConstraints<2>, [usize; 2]), SolverError> {
+/// The cantilever as a scene (the text of
+/// `scenes/coombs2020_cantilever.toml` with the parameters and variant
+/// filled in): a grid with room below for a tip deflection of about the
+/// beam length and the padding the basis needs; the root a wall (every
+/// node on x = 0 on a roller, so that GIMP and CPDI2 corners near the root
+/// stay on it; padding nodes beyond it free) with its neutral-axis node
+/// pinned; the end load shared by the two points of the last lattice
+/// column that straddle the neutral axis.
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] unless `h` divides half the depth and the
+/// length and `points_per_cell` is even.
+pub fn scene_text(p: &CantileverParams, variant: &Variant) -> Result<String, SolverError> {
     let half = p.depth / 2.0;
     let k = (half / p.h).round();
     if k < 1.0
@@ -130,49 +135,66 @@ pub fn geometry(
             p.h, p.points_per_cell
         )));
     }
-    let padf = pad as f64 * p.h;
     // Room below for a tip deflection of about the beam length.
     let below = (p.length / p.h).ceil() * p.h;
-    let grid = RegularGrid::new(
-        SVector::<f64, 2>::new(-padf, -below - padf),
-        SVector::<f64, 2>::new(p.h, p.h),
-        [
-            ((p.length + 1.0) / p.h).ceil() as usize + 2 * pad,
-            ((below + p.depth + 0.5) / p.h).ceil() as usize + 2 * pad,
-        ],
-    )
-    .map_err(SolverError::from)?;
-    let body = Body::fill_box(
-        &grid,
-        &SVector::<f64, 2>::zeros(),
-        &SVector::<f64, 2>::new(p.length, p.depth),
-        p.points_per_cell,
-    );
-    let mut constraints = NodalConstraints::<2>::new(grid.node_count());
-    let tol = 1e-9 * p.h;
-    for n in 0..grid.node_count() {
-        let x = grid.node_position(n).map_err(SolverError::from)?;
-        // The root is a wall: every grid node on it is on a roller (CPDI2
-        // and GIMP corners near the root then stay on it), the neutral
-        // axis is pinned.
-        if x[0].abs() <= tol {
-            constraints.fix([n], 0);
-            if (x[1] - half).abs() <= tol {
-                constraints.fix([n], 1);
-            }
+    let cells = [
+        ((p.length + 1.0) / p.h).ceil() as usize,
+        ((below + p.depth + 0.5) / p.h).ceil() as usize,
+    ];
+    let (tol, step) = (1e-9 * p.h, p.h / p.points_per_cell as f64);
+    let (y_lo, y_hi) = (-below - 2.0 * p.h, p.depth + 2.0 * p.h + 0.5);
+    Ok(format!(
+        "[mesh]\norigin = [0.0, {oy:?}]\nsize = [{sx:?}, {sy:?}]\ncells = [{cx}, {cy}]\n\n\
+         [[material]]\nname = \"beam\"\nmodel = \"hencky\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\n\n\
+         [[body]]\nname = \"beam\"\nmaterial = \"beam\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [{l:?}, {d:?}] }} }}\npoints_per_cell = {ppc}\n\n\
+         [[node_set]]\nname = \"root\"\nregion = {{ box = {{ lower = [{mt:?}, {y_lo:?}], upper = [{tol:?}, {y_hi:?}] }} }}\n\n\
+         [[node_set]]\nname = \"neutral_axis_at_root\"\nregion = {{ box = {{ lower = [{mt:?}, {na_lo:?}], upper = [{tol:?}, {na_hi:?}] }} }}\n\n\
+         [[boundary]]\nset = \"root\"\nkind = \"displacement\"\ndisplacement = {{ x = 0.0 }}\n\n\
+         [[boundary]]\nset = \"neutral_axis_at_root\"\nkind = \"fixed\"\n\n\
+         [[load]]\nkind = \"point\"\nregion = {{ box = {{ lower = [{lx:?}, {ly_lo:?}], upper = [{l:?}, {ly_hi:?}] }} }}\nforce = [0.0, {f:?}]\n\n{solver}",
+        oy = -below,
+        sx = cells[0] as f64 * p.h,
+        sy = cells[1] as f64 * p.h,
+        cx = cells[0],
+        cy = cells[1],
+        e = p.youngs_modulus,
+        nu = p.poisson_ratio,
+        l = p.length,
+        d = p.depth,
+        ppc = p.points_per_cell,
+        mt = -tol,
+        na_lo = half - tol,
+        na_hi = half + tol,
+        lx = p.length - step,
+        ly_lo = half - step,
+        ly_hi = half + step,
+        f = -p.load,
+        solver = super::solver_section(variant, p.load_steps, p.tolerance),
+    ))
+}
+
+/// The cantilever's scene, built, and the indices of its two loaded
+/// points.
+///
+/// # Errors
+/// As [`scene_text`], the scene's own checks, and an end that does not
+/// hold exactly two points.
+pub fn problem(
+    p: &CantileverParams,
+    variant: &Variant,
+) -> Result<(Problem<2>, [usize; 2]), SolverError> {
+    let problem = super::build_scene(
+        &scene_text(p, variant)?,
+        "cantilever",
+        variant.basis.padding(),
+    )?;
+    match problem.point_forces.as_slice() {
+        [(a, _), (b, _)] => {
+            let loaded = [*a, *b];
+            Ok((problem, loaded))
         }
-    }
-    let [nx, ny] = body.lattice_size;
-    let loaded = |row: usize| {
-        body.lattice
-            .iter()
-            .position(|l| l[0] == nx - 1 && l[1] == row)
-    };
-    let (a, b) = (loaded(ny / 2 - 1), loaded(ny / 2));
-    match (a, b) {
-        (Some(a), Some(b)) => Ok((grid, body, constraints, [a, b])),
         _ => Err(SolverError::InvalidInput(
-            "no material points at the loaded end".into(),
+            "the loaded end must hold two material points".into(),
         )),
     }
 }
@@ -183,68 +205,37 @@ pub fn tip_displacement(snap: &Snapshot, loaded: [usize; 2]) -> (f64, f64) {
     (0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]))
 }
 
-struct CantileverRun<'a, O> {
-    params: &'a CantileverParams,
-    control: &'a RunControl,
-    observer: O,
-}
-
-impl<O> VariantVisitor<2> for CantileverRun<'_, O>
+/// Runs the built cantilever, recording the tip after every step.
+///
+/// # Errors
+/// Whatever the run returns.
+pub fn run_problem<O>(
+    problem: &Problem<2>,
+    loaded: [usize; 2],
+    control: &RunControl,
+    mut observer: O,
+) -> Result<CantileverResult, SolverError>
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    type Output = Result<CantileverResult, SolverError>;
-
-    fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
-    where
-        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
-        F: Formulation,
-        U: DomainUpdater<2, B::Domain>,
-    {
-        let p = self.params;
-        let (grid, body, constraints, loaded) = geometry(p, B::PADDING)?;
-        let law =
-            HenckyElastic::new(p.youngs_modulus, p.poisson_ratio).map_err(SolverError::from)?;
-        let force = SVector::<f64, 2>::new(0.0, -p.load / 2.0);
-        let setup = Setup {
-            grid,
-            body: &body,
-            density: 0.0,
-            law,
-            loads: Loads {
-                gravity: None,
-                point_forces: vec![(loaded[0], force), (loaded[1], force)],
-                body_force_path: None,
-            },
-            constraints,
-            stepping: LoadStepping::uniform(p.load_steps),
-            newton: NewtonOptions {
-                tolerance: p.tolerance,
-                ..NewtonOptions::default()
-            },
-        };
-        let mut tip = Vec::new();
-        let mut observer = self.observer;
-        let output = simulate::<2, B, F, U, _, _, _>(
-            setup,
-            basis,
-            updater,
-            self.control,
-            |step, report, snap| {
-                let (ux, uy) = tip_displacement(snap, loaded);
-                tip.push((report.lambda1, ux, uy));
-                observer(step, report, snap)
-            },
-        )?;
-        Ok(CantileverResult {
-            output,
-            tip,
-            material_points: body.len(),
-        })
-    }
+    let mut tip = Vec::new();
+    let output = crate::scene::run(problem, control, |step, report, snap| {
+        let (ux, uy) = tip_displacement(snap, loaded);
+        tip.push((report.lambda1, ux, uy));
+        observer(step, report, snap)
+    })?;
+    Ok(CantileverResult {
+        output,
+        tip,
+        material_points: problem.len(),
+    })
 }
 
-/// Runs the cantilever with `variant`.
+/// Runs the cantilever with `variant`: its scene ([`scene_text`]), built
+/// and run.
+///
+/// # Errors
+/// As [`problem`] and [`run_problem`].
 pub fn run<O>(
     params: &CantileverParams,
     variant: &Variant,
@@ -254,15 +245,8 @@ pub fn run<O>(
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    dispatch(
-        variant,
-        CantileverRun {
-            params,
-            control,
-            observer,
-        },
-    )
-    .map_err(SolverError::InvalidInput)?
+    let (problem, loaded) = problem(params, variant)?;
+    run_problem(&problem, loaded, control, observer)
 }
 
 /// The large-deflection (elastica) solution of an inextensible cantilever

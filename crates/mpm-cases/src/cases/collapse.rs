@@ -14,17 +14,11 @@
 //! points per cell), while the bare point positions fall short by exactly
 //! $l^0_p$ (1.2 % and 2.7 % for 3²).
 
-use mpm_constitutive::VonMises;
-use mpm_mesh::RegularGrid;
-use mpm_solver::{
-    DomainUpdater, Flat, Formulation, LoadStepping, NewtonOptions, NodalConstraints, SolverError,
-    StepReport,
-};
-use nalgebra::SVector;
+use mpm_solver::{SolverError, StepReport};
 
-use crate::body::{Body, InitialDomain};
-use crate::run::{DomainBounds, Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
-use crate::variant::{Variant, VariantVisitor, dispatch};
+use crate::run::{RunControl, RunOutput, Snapshot};
+use crate::scene::Problem;
+use crate::variant::Variant;
 
 crate::case_params! {
     /// Parameters of the collapse case (defaults: the paper's values).
@@ -65,11 +59,12 @@ impl crate::cases::Case for CollapseCase {
 
     fn run(p: CollapseParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
         use crate::session::summary;
-        let (grid, _, _) = geometry(&p, p.basis.padding())?;
-        let (mut obs, control) = session.start(&p, grid)?;
-        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
-            obs.step(s, rep, snap)
-        })?;
+        let problem = problem(&p, &p.variant())?;
+        let crate::scene::build::SceneMesh::Grid(grid) = &problem.mesh else {
+            return Err(SolverError::InvalidInput("the collapse runs on a grid".into()).into());
+        };
+        let (mut obs, control) = session.start(&p, grid.clone())?;
+        let r = run_problem(&problem, &control, |s, rep, snap| obs.step(s, rep, snap))?;
         let mut results = serde_json::Map::new();
         results.insert(
             "horizontal_extent".into(),
@@ -103,12 +98,16 @@ pub struct CollapseResult {
     pub material_points: usize,
 }
 
-/// Grid, body and rollers; a basis that needs padding gets that many cells
-/// beyond the rollers, whose nodes are held like the roller they extend.
-pub fn geometry(
-    p: &CollapseParams,
-    pad: usize,
-) -> Result<(RegularGrid<2>, Body<2>, NodalConstraints<2>), SolverError> {
+/// The collapse as a scene (the text of `scenes/coombs2020_collapse.toml`
+/// with the parameters and variant filled in): a grid of `grid_width` by
+/// `height + h` with the padding the basis needs, rollers on the base and
+/// the symmetry line (their padding nodes held alike), the body force as
+/// the weight of a unit density.
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] when `h` does not divide the widths and
+/// the height.
+pub fn scene_text(p: &CollapseParams, variant: &Variant) -> Result<String, SolverError> {
     let cells = |len: f64, what: &str| {
         let n = (len / p.h).round();
         if n < 1.0 || (n * p.h - len).abs() > 1e-9 * len {
@@ -125,103 +124,83 @@ pub fn geometry(
         cells(p.height, "height")?,
     );
     cells(p.width, "block width")?;
-    let padf = pad as f64 * p.h;
-    let grid = RegularGrid::new(
-        SVector::<f64, 2>::new(-padf, -padf),
-        SVector::<f64, 2>::new(p.h, p.h),
-        [nx + 2 * pad, ny + 1 + 2 * pad],
+    Ok(format!(
+        "[mesh]\norigin = [0.0, 0.0]\nsize = [{gw:?}, {gh:?}]\ncells = [{nx}, {cy}]\n\n\
+         [[material]]\nname = \"block\"\nmodel = \"von_mises\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 1.0\nyield_stress = {ys:?}\n\n\
+         [[body]]\nname = \"block\"\nmaterial = \"block\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [{w:?}, {hh:?}] }} }}\npoints_per_cell = {ppc}\n\n\
+         [[boundary]]\nset = \"x_min\"\nkind = \"roller\"\n\n\
+         [[boundary]]\nset = \"y_min\"\nkind = \"roller\"\n\n\
+         [[load]]\nkind = \"gravity\"\nacceleration = [0.0, {g:?}]\n\n{solver}",
+        gw = p.grid_width,
+        gh = p.height + p.h,
+        cy = ny + 1,
+        e = p.youngs_modulus,
+        nu = p.poisson_ratio,
+        ys = p.yield_stress,
+        w = p.width,
+        hh = p.height,
+        ppc = p.points_per_cell,
+        g = -p.body_force,
+        solver = super::solver_section(variant, p.load_steps, p.tolerance),
+    ))
+}
+
+/// The collapse's scene, built.
+///
+/// # Errors
+/// As [`scene_text`], and the scene's own checks.
+pub fn problem(p: &CollapseParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
+    super::build_scene(
+        &scene_text(p, variant)?,
+        "collapse",
+        variant.basis.padding(),
     )
-    .map_err(SolverError::from)?;
-    let body = Body::fill_box(
-        &grid,
-        &SVector::<f64, 2>::zeros(),
-        &SVector::<f64, 2>::new(p.width, p.height),
-        p.points_per_cell,
-    );
-    let mut constraints = NodalConstraints::<2>::new(grid.node_count());
-    let tol = 1e-9 * p.h;
-    for n in 0..grid.node_count() {
-        let x = grid.node_position(n).map_err(SolverError::from)?;
-        if x[0] <= tol {
-            constraints.fix([n], 0);
-        }
-        if x[1] <= tol {
-            constraints.fix([n], 1);
-        }
-    }
-    Ok((grid, body, constraints))
 }
 
-struct CollapseRun<'a, O> {
-    params: &'a CollapseParams,
-    control: &'a RunControl,
+/// Runs the built collapse and measures the body's extent.
+///
+/// # Errors
+/// Whatever the run returns.
+pub fn run_problem<O>(
+    problem: &Problem<2>,
+    control: &RunControl,
     observer: O,
-}
-
-impl<O> VariantVisitor<2> for CollapseRun<'_, O>
+) -> Result<CollapseResult, SolverError>
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    type Output = Result<CollapseResult, SolverError>;
-
-    fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
-    where
-        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
-        F: Formulation,
-        U: DomainUpdater<2, B::Domain>,
-    {
-        let p = self.params;
-        let (grid, body, constraints) = geometry(p, B::PADDING)?;
-        let law = VonMises::new(p.youngs_modulus, p.poisson_ratio, p.yield_stress, 0.0)
-            .map_err(SolverError::from)?;
-        // The body force is applied as m_p g with unit density.
-        let setup = Setup {
-            grid,
-            body: &body,
-            density: 1.0,
-            law,
-            loads: Loads {
-                gravity: Some(SVector::<f64, 2>::new(0.0, -p.body_force)),
-                point_forces: Vec::new(),
-                body_force_path: None,
-            },
-            constraints,
-            stepping: LoadStepping::uniform(p.load_steps),
-            newton: NewtonOptions {
-                tolerance: p.tolerance,
-                ..NewtonOptions::default()
-            },
-        };
-        let output =
-            simulate::<2, B, F, U, _, _, _>(setup, basis, updater, self.control, self.observer)?;
-        // The edge of the body: of the domains where the basis has them
-        // (GIMP, CPDI2), else of the points' initial half-spacing l0.
-        let last = &output.last;
-        let edge = |axis: usize| {
-            if last.domain_bounds.is_empty() {
-                last.position
-                    .iter()
-                    .zip(&body.half_lengths)
-                    .map(|(x, l)| x[axis] + l[axis])
-                    .fold(f64::NEG_INFINITY, f64::max)
-            } else {
-                last.domain_bounds
-                    .iter()
-                    .map(|(_, hi)| hi[axis])
-                    .fold(f64::NEG_INFINITY, f64::max)
-            }
-        };
-        let (horizontal_extent, max_height) = (edge(0), edge(1));
-        Ok(CollapseResult {
-            output,
-            horizontal_extent,
-            max_height,
-            material_points: body.len(),
-        })
-    }
+    let output = crate::scene::run(problem, control, observer)?;
+    // The edge of the body: of the domains where the basis has them
+    // (GIMP, CPDI2), else of the points' initial half-spacing l0.
+    let last = &output.last;
+    let edge = |axis: usize| {
+        if last.domain_bounds.is_empty() {
+            last.position
+                .iter()
+                .zip(&problem.half_lengths)
+                .map(|(x, l)| x[axis] + l[axis])
+                .fold(f64::NEG_INFINITY, f64::max)
+        } else {
+            last.domain_bounds
+                .iter()
+                .map(|(_, hi)| hi[axis])
+                .fold(f64::NEG_INFINITY, f64::max)
+        }
+    };
+    let (horizontal_extent, max_height) = (edge(0), edge(1));
+    Ok(CollapseResult {
+        output,
+        horizontal_extent,
+        max_height,
+        material_points: problem.len(),
+    })
 }
 
-/// Runs the collapse with `variant`.
+/// Runs the collapse with `variant`: its scene ([`scene_text`]), built and
+/// run.
+///
+/// # Errors
+/// As [`problem`] and [`run_problem`].
 pub fn run<O>(
     params: &CollapseParams,
     variant: &Variant,
@@ -231,13 +210,5 @@ pub fn run<O>(
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    dispatch(
-        variant,
-        CollapseRun {
-            params,
-            control,
-            observer,
-        },
-    )
-    .map_err(SolverError::InvalidInput)?
+    run_problem(&problem(params, variant)?, control, observer)
 }

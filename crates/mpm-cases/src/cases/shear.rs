@@ -40,19 +40,12 @@
 use mpm_constitutive::{
     HenckyElastic, LogStrainLaw, MaterialState, VonMises, tensor::embed, update,
 };
-use mpm_mesh::RegularGrid;
-use mpm_solver::{
-    Constraints, DomainUpdater, Flat, Formulation, LoadStepping, NewtonOptions, SolverError,
-    StepReport, StepView,
-};
-use nalgebra::{Matrix2, Matrix3, SVector};
+use mpm_solver::{Flat, SolverError, StepReport};
+use nalgebra::{Matrix2, Matrix3};
 
-use crate::body::{Body, InitialDomain};
-use crate::run::{
-    Checkpoint, DomainBounds, HistoryOutput, Loads, RunControl, RunOutput, Setup, Snapshot,
-    simulate,
-};
-use crate::variant::{Variant, VariantVisitor, dispatch};
+use crate::run::{Checkpoint, RunControl, RunOutput, Snapshot};
+use crate::scene::Problem;
+use crate::variant::Variant;
 
 crate::case_params! {
     /// Parameters of the shear case (defaults: the paper's values).
@@ -94,9 +87,12 @@ impl crate::cases::Case for ShearCase {
 
     fn run(p: ShearParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
         use crate::session::summary;
-        let grid = grid(&p, p.basis.padding())?;
-        let (mut obs, control) = session.start(&p, grid)?;
-        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+        let problem = problem(&p, &p.variant())?;
+        let crate::scene::build::SceneMesh::Grid(grid) = &problem.mesh else {
+            return Err(SolverError::InvalidInput("the shear runs on a grid".into()).into());
+        };
+        let (mut obs, control) = session.start(&p, grid.clone())?;
+        let r = run_problem(&p, &problem, &control, |s, rep, snap| {
             obs.step(s, rep, snap)
         })?;
         let s = summary(
@@ -109,40 +105,6 @@ impl crate::cases::Case for ShearCase {
             &p,
         );
         obs.finish(s)
-    }
-}
-
-/// Prescribed shear on every node supporting a boundary point.
-#[derive(Debug, Clone)]
-struct BoundaryCellShear {
-    grid: RegularGrid<2>,
-    boundary_points: Vec<usize>,
-    prescribed: Vec<bool>,
-    shear: f64,
-}
-
-impl Constraints<2> for BoundaryCellShear {
-    fn begin_step(&mut self, step: &StepView<'_, 2>) {
-        self.prescribed.iter_mut().for_each(|p| *p = false);
-        for &p in &self.boundary_points {
-            for v in step.nodes_of(p) {
-                if let Some(flag) = self.prescribed.get_mut(v) {
-                    *flag = true;
-                }
-            }
-        }
-    }
-
-    fn prescribed(&self, node: usize, component: usize, lambda0: f64, lambda1: f64) -> Option<f64> {
-        if !self.prescribed.get(node).copied().unwrap_or(false) {
-            return None;
-        }
-        let y = self.grid.node_position(node).map(|x| x[1]).unwrap_or(0.0);
-        Some(if component == 0 {
-            self.shear * (lambda1 - lambda0) * y
-        } else {
-            0.0
-        })
     }
 }
 
@@ -222,9 +184,17 @@ pub fn elastic_closed_form(mu: f64, gamma: f64) -> Matrix3<f64> {
     Matrix3::new(s11, s12, 0.0, s12, -s11, 0.0, 0.0, 0.0, 0.0)
 }
 
-/// The background grid: h-spaced, shifted left of the body by
-/// `grid_offset`·h, with room for the shear and `pad` padding cells.
-pub fn grid(p: &ShearParams, pad: usize) -> Result<RegularGrid<2>, SolverError> {
+/// The shear as a scene (the text of `scenes/coombs2020_shear.toml` with
+/// the parameters and variant filled in): an h-spaced grid shifted left of
+/// the body by `grid_offset`·h, with room for the shear and the padding the
+/// basis needs; the unit square's points on a lattice anchored at its
+/// corner; $\Delta u = \Delta\gamma\,(Y_v, 0)$ on every node that
+/// supports a boundary point, found again every step (`around`).
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] unless `h` divides 1 and `grid_offset`
+/// lies in [0, 1).
+pub fn scene_text(p: &ShearParams, variant: &Variant) -> Result<String, SolverError> {
     let cells = (1.0 / p.h).round();
     if cells < 1.0 || (cells * p.h - 1.0).abs() > 1e-9 {
         return Err(SolverError::InvalidInput(format!(
@@ -232,159 +202,54 @@ pub fn grid(p: &ShearParams, pad: usize) -> Result<RegularGrid<2>, SolverError> 
             p.h
         )));
     }
-    let padf = pad as f64 * p.h;
-    let nx = ((1.0 + p.shear.abs()) / p.h).ceil() as usize + 1;
-    let offset = p.grid_offset * p.h;
-    RegularGrid::new(
-        SVector::<f64, 2>::new(
-            -padf
-                - offset
-                - if p.shear < 0.0 {
-                    p.shear.abs() + p.h
-                } else {
-                    0.0
-                },
-            -padf,
-        ),
-        SVector::<f64, 2>::new(p.h, p.h),
-        [nx + 1 + 2 * pad, cells as usize + 2 * pad],
-    )
-    .map_err(SolverError::from)
-}
-
-struct ShearRun<'a, O> {
-    params: &'a ShearParams,
-    control: &'a RunControl,
-    observer: O,
-}
-
-impl<O> ShearRun<'_, O>
-where
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    fn go<B, F, U, L>(self, basis: B, updater: U, law: L) -> Result<ShearResult, SolverError>
-    where
-        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
-        F: Formulation,
-        U: DomainUpdater<2, B::Domain>,
-        L: LogStrainLaw + Clone,
-        L::History: HistoryOutput + Flat,
-    {
-        let p = self.params;
-        let grid = grid(p, B::PADDING)?;
-        if !(0.0..1.0).contains(&p.grid_offset) {
-            return Err(SolverError::InvalidInput(format!(
-                "grid_offset = {} must lie in [0, 1)",
-                p.grid_offset
-            )));
-        }
-        let body = Body::fill_box(
-            &grid,
-            &SVector::<f64, 2>::zeros(),
-            &SVector::<f64, 2>::new(1.0, 1.0),
-            p.points_per_cell,
-        );
-        let [nxp, nyp] = body.lattice_size;
-        let boundary_points = (0..body.len())
-            .filter(|&q| {
-                let [i, j] = body.lattice[q];
-                i == 0 || j == 0 || i + 1 == nxp || j + 1 == nyp
-            })
-            .collect();
-        let constraints = BoundaryCellShear {
-            prescribed: vec![false; grid.node_count()],
-            grid: grid.clone(),
-            boundary_points,
-            shear: p.shear,
-        };
-        let mut reference = SinglePoint::new(law.clone());
-        let setup = Setup {
-            grid,
-            body: &body,
-            density: 0.0,
-            law,
-            loads: Loads::default(),
-            constraints,
-            stepping: LoadStepping::uniform(p.load_steps),
-            newton: NewtonOptions {
-                tolerance: p.tolerance,
-                predictor: p.predictor,
-                ..NewtonOptions::default()
-            },
-        };
-        // On resume: the largest error so far and the reference's state.
-        let mut error = 0.0f64;
-        if let Some(c) = &self.control.resume {
-            let (first, rest) = c.case_state.split_first().ok_or_else(|| {
-                SolverError::InvalidInput("the checkpoint has no shear reference".into())
-            })?;
-            error = *first;
-            reference.restore(rest)?;
-        }
-        let mut observer = self.observer;
-        let output = simulate::<2, B, F, U, _, _, _>(
-            setup,
-            basis,
-            updater,
-            self.control,
-            |step, report, snap| {
-                // The reference follows the increments actually taken (a cut
-                // step changes the plastic path).
-                let sigma_ref = reference.shear(p.shear * (report.lambda1 - report.lambda0))?;
-                for s in &snap.sigma {
-                    let sigma = Matrix3::from_row_slice(s);
-                    error = error.max((sigma - sigma_ref).norm() / sigma_ref.norm());
-                }
-                match &snap.checkpoint {
-                    Some(c) => {
-                        let mut case_state = vec![error];
-                        reference.save(&mut case_state);
-                        let mut snap = snap.clone();
-                        snap.checkpoint = Some(Checkpoint {
-                            case_state,
-                            ..c.clone()
-                        });
-                        observer(step, report, &snap)
-                    }
-                    None => observer(step, report, snap),
-                }
-            },
-        )?;
-        Ok(ShearResult {
-            output,
-            error,
-            material_points: body.len(),
-        })
+    if !(0.0..1.0).contains(&p.grid_offset) {
+        return Err(SolverError::InvalidInput(format!(
+            "grid_offset = {} must lie in [0, 1)",
+            p.grid_offset
+        )));
     }
+    let nx = ((1.0 + p.shear.abs()) / p.h).ceil() as usize + 2;
+    let ny = cells as usize;
+    let left = if p.shear < 0.0 {
+        p.shear.abs() + p.h
+    } else {
+        0.0
+    };
+    let plastic = match p.yield_stress {
+        Some(y) => format!("model = \"von_mises\"\nyield_stress = {y:?}\n"),
+        None => "model = \"hencky\"\n".to_owned(),
+    };
+    Ok(format!(
+        "[mesh]\norigin = [{ox:?}, 0.0]\nsize = [{sx:?}, {sy:?}]\ncells = [{nx}, {ny}]\n\n\
+         [[material]]\nname = \"square\"\n{plastic}youngs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\n\n\
+         [[body]]\nname = \"square\"\nmaterial = \"square\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [1.0, 1.0] }} }}\npoints_per_cell = {ppc}\nlattice_origin = [0.0, 0.0]\n\n\
+         [[node_set]]\nname = \"shell\"\naround = \"square\"\n\n\
+         [[boundary]]\nset = \"shell\"\nkind = \"displacement\"\ngradient = [[0.0, {g:?}], [0.0, 0.0]]\n\n{solver}predictor = {pred}\n",
+        ox = -p.grid_offset * p.h - left,
+        sx = nx as f64 * p.h,
+        sy = ny as f64 * p.h,
+        e = p.youngs_modulus,
+        nu = p.poisson_ratio,
+        ppc = p.points_per_cell,
+        g = p.shear,
+        solver = super::solver_section(variant, p.load_steps, p.tolerance),
+        pred = p.predictor,
+    ))
 }
 
-impl<O> VariantVisitor<2> for ShearRun<'_, O>
-where
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    type Output = Result<ShearResult, SolverError>;
-
-    fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
-    where
-        B: InitialDomain<2, Mesh = RegularGrid<2>, Domain: Flat + DomainBounds<2>>,
-        F: Formulation,
-        U: DomainUpdater<2, B::Domain>,
-    {
-        let p = self.params;
-        match p.yield_stress {
-            None => {
-                let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio)?;
-                self.go::<B, F, U, _>(basis, updater, law)
-            }
-            Some(y) => {
-                let law = VonMises::new(p.youngs_modulus, p.poisson_ratio, y, 0.0)?;
-                self.go::<B, F, U, _>(basis, updater, law)
-            }
-        }
-    }
+/// The shear's scene, built.
+///
+/// # Errors
+/// As [`scene_text`], and the scene's own checks.
+pub fn problem(p: &ShearParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
+    super::build_scene(&scene_text(p, variant)?, "shear", variant.basis.padding())
 }
 
-/// Runs the shear with `variant`.
+/// Runs the shear with `variant`: its scene ([`scene_text`]), built and
+/// run, every point's stress measured against the single-point reference.
+///
+/// # Errors
+/// As [`problem`] and [`run_problem`].
 pub fn run<O>(
     params: &ShearParams,
     variant: &Variant,
@@ -394,13 +259,81 @@ pub fn run<O>(
 where
     O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
-    dispatch(
-        variant,
-        ShearRun {
-            params,
-            control,
-            observer,
-        },
-    )
-    .map_err(SolverError::InvalidInput)?
+    run_problem(params, &problem(params, variant)?, control, observer)
+}
+
+/// Runs the built shear against the single-point reference of its law.
+///
+/// # Errors
+/// Whatever the run returns.
+pub fn run_problem<O>(
+    p: &ShearParams,
+    problem: &Problem<2>,
+    control: &RunControl,
+    observer: O,
+) -> Result<ShearResult, SolverError>
+where
+    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
+{
+    match p.yield_stress {
+        None => {
+            let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio)?;
+            with_reference(p, problem, control, observer, law)
+        }
+        Some(y) => {
+            let law = VonMises::new(p.youngs_modulus, p.poisson_ratio, y, 0.0)?;
+            with_reference(p, problem, control, observer, law)
+        }
+    }
+}
+
+fn with_reference<L, O>(
+    p: &ShearParams,
+    problem: &Problem<2>,
+    control: &RunControl,
+    mut observer: O,
+    law: L,
+) -> Result<ShearResult, SolverError>
+where
+    L: LogStrainLaw,
+    L::History: Flat,
+    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
+{
+    let mut reference = SinglePoint::new(law);
+    // On resume: the largest error so far and the reference's state.
+    let mut error = 0.0f64;
+    if let Some(c) = &control.resume {
+        let (first, rest) = c.case_state.split_first().ok_or_else(|| {
+            SolverError::InvalidInput("the checkpoint has no shear reference".into())
+        })?;
+        error = *first;
+        reference.restore(rest)?;
+    }
+    let output = crate::scene::run(problem, control, |step, report, snap| {
+        // The reference follows the increments actually taken (a cut step
+        // changes the plastic path).
+        let sigma_ref = reference.shear(p.shear * (report.lambda1 - report.lambda0))?;
+        for s in &snap.sigma {
+            let sigma = Matrix3::from_row_slice(s);
+            error = error.max((sigma - sigma_ref).norm() / sigma_ref.norm());
+        }
+        match &snap.checkpoint {
+            Some(c) => {
+                let mut case_state = vec![error];
+                reference.save(&mut case_state);
+                let mut snap = snap.clone();
+                snap.checkpoint = Some(Checkpoint {
+                    case_state,
+                    ..c.clone()
+                });
+                observer(step, report, &snap)
+            }
+            None => observer(step, report, snap),
+        }
+    })?;
+    Ok(ShearResult {
+        output,
+        error,
+        material_points: problem.len(),
+    })
 }

@@ -26,18 +26,12 @@
 
 use std::path::PathBuf;
 
-use mpm_basis::LinearSimplex;
-use mpm_constitutive::VonMises;
-use mpm_mesh::{BoxMesh, GmshElements, PatchMesh, SimplexMesh, read_msh};
-use mpm_solver::{
-    Formulation, LoadStepping, MovingMesh, NewtonOptions, NoUpdate, NodalConstraints,
-    PreviouslyConverged, SolverError, StepReport, Stretch, UpdatedLagrangian,
-};
-use nalgebra::{Matrix3, Vector3};
+use mpm_solver::{SolverError, StepReport};
+use nalgebra::Matrix3;
 
-use crate::body::{Body, SimplexRule};
-use crate::run::{Loads, RunControl, RunOutput, Setup, Snapshot, simulate};
-use crate::variant::{FormulationKind, Variant};
+use crate::run::{RunControl, RunOutput, Snapshot};
+use crate::scene::Problem;
+use crate::variant::Variant;
 
 crate::case_params! {
     /// Parameters of the stretch case (defaults: Wang 2021 Table 1).
@@ -97,9 +91,12 @@ impl crate::cases::Case for StretchCase {
     ) -> Result<(), crate::CasesError> {
         use crate::session::summary;
         session.resolve(&mut p.mesh);
-        let mesh = mesh(&p)?;
-        let (mut obs, control) = session.start(&p, mesh)?;
-        let r = run(&p, &p.variant(), &control, |s, rep, snap| {
+        let problem = problem(&p, &p.variant())?;
+        let crate::scene::build::SceneMesh::Simplex(mesh) = &problem.mesh else {
+            return Err(SolverError::InvalidInput("the stretch runs on tetrahedra".into()).into());
+        };
+        let (mut obs, control) = session.start(&p, (**mesh).clone())?;
+        let r = run_problem(&p, &problem, &control, |s, rep, snap| {
             obs.step(s, rep, snap)
         })?;
         let mut results = serde_json::Map::new();
@@ -152,28 +149,74 @@ pub struct StretchResult {
     pub elements: usize,
 }
 
-/// The background mesh of linear tetrahedra.
-pub fn mesh(p: &StretchParams) -> Result<SimplexMesh<3>, SolverError> {
-    let invalid = SolverError::from;
-    let quadratic = match &p.mesh {
-        Some(path) => match read_msh::<3>(path).map_err(invalid)?.elements {
-            GmshElements::Linear(mesh) => return Ok(mesh),
-            GmshElements::Quadratic(q) => q,
-        },
-        None => BoxMesh::new(
-            Vector3::zeros(),
-            Vector3::from_element(p.size),
-            [p.cells, 2, p.cells],
-        )
-        .quadratic_mesh()
-        .map_err(invalid)?,
+/// The stretch as a scene (the text of `scenes/wang2021_stretch.toml`
+/// with the parameters filled in): the cube of `cells` × 2 × `cells`
+/// cells, each split into six ten-node tetrahedra and those into their
+/// eight linear children (or the Gmsh file `mesh`), Keast's 11 points per
+/// child, the faces x0, y0, z0 on rollers, the mesh stretching along y
+/// with the face y1 driven (also laterally with `clamped_top`).
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] for a variant other than standard MPM.
+pub fn scene_text(p: &StretchParams, variant: &Variant) -> Result<String, SolverError> {
+    variant
+        .require_standard_mpm("tetrahedra")
+        .map_err(SolverError::InvalidInput)?;
+    let mesh = match &p.mesh {
+        Some(path) => format!(
+            "kind = \"gmsh\"\nfile = {}\ndimension = 3\n",
+            toml::Value::String(path.display().to_string())
+        ),
+        None => format!(
+            "kind = \"simplex\"\norigin = [0.0, 0.0, 0.0]\nsize = [{a:?}, {a:?}, {a:?}]\ncells = [{c}, 2, {c}]\npatches = true\n",
+            a = p.size,
+            c = p.cells
+        ),
     };
-    Ok(PatchMesh::from_parents(&quadratic)
-        .map_err(invalid)?
-        .into_mesh())
+    let components = if p.clamped_top {
+        "[\"x\", \"y\", \"z\"]"
+    } else {
+        "[\"y\"]"
+    };
+    let roller = |set: &str, axis: &str| {
+        format!(
+            "[[boundary]]\nset = \"{set}\"\nkind = \"displacement\"\ndisplacement = {{ {axis} = 0.0 }}\n\n"
+        )
+    };
+    Ok(format!(
+        "[mesh]\n{mesh}\n\
+         [mesh.motion]\nkind = \"stretch\"\naxis = \"y\"\norigin = 0.0\nlength = {a:?}\nextension = {x:?}\ndriven = \"y1\"\ncomponents = {components}\n\n\
+         [[material]]\nname = \"cube\"\nmodel = \"von_mises\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\nyield_stress = {ys:?}\nhardening = {hd:?}\n\n\
+         [[body]]\nname = \"cube\"\nmaterial = \"cube\"\nregion = {{ box = {{ lower = [0.0, 0.0, 0.0], upper = [{a:?}, {a:?}, {a:?}] }} }}\nplacement = \"keast11\"\n\n\
+         {rx}{ry}{rz}{solver}predictor = {pred}\n",
+        a = p.size,
+        x = p.stretch,
+        e = p.youngs_modulus,
+        nu = p.poisson_ratio,
+        ys = p.yield_stress,
+        hd = p.hardening,
+        rx = roller("x0", "x"),
+        ry = roller("y0", "y"),
+        rz = roller("z0", "z"),
+        solver = super::solver_section(variant, p.load_steps, p.tolerance),
+        pred = p.predictor,
+    ))
 }
 
-/// Runs the stretch with `variant` (standard MPM on tetrahedra; UL or PC).
+/// The stretch's scene, built.
+///
+/// # Errors
+/// As [`scene_text`], and the scene's own checks.
+pub fn problem(p: &StretchParams, variant: &Variant) -> Result<Problem<3>, SolverError> {
+    super::build_scene(&scene_text(p, variant)?, "stretch", 0)
+}
+
+/// Runs the stretch with `variant` (standard MPM on tetrahedra; UL or PC):
+/// its scene ([`scene_text`]), built and run, measured against the
+/// uniaxial stress.
+///
+/// # Errors
+/// As [`problem`] and [`run_problem`].
 pub fn run<O>(
     p: &StretchParams,
     variant: &Variant,
@@ -183,78 +226,28 @@ pub fn run<O>(
 where
     O: FnMut(usize, &StepReport<3>, &Snapshot) -> Result<(), SolverError>,
 {
-    variant
-        .require_standard_mpm("tetrahedra")
-        .map_err(SolverError::InvalidInput)?;
-    match variant.formulation {
-        FormulationKind::Pc => go::<PreviouslyConverged, _>(p, control, observer),
-        FormulationKind::Ul => go::<UpdatedLagrangian, _>(p, control, observer),
-    }
+    run_problem(p, &problem(p, variant)?, control, observer)
 }
 
-fn go<F: Formulation, O>(
+/// Runs the built stretch and measures it.
+///
+/// # Errors
+/// Whatever the run returns.
+pub fn run_problem<O>(
     p: &StretchParams,
+    problem: &Problem<3>,
     control: &RunControl,
     observer: O,
 ) -> Result<StretchResult, SolverError>
 where
     O: FnMut(usize, &StepReport<3>, &Snapshot) -> Result<(), SolverError>,
 {
-    let mesh = mesh(p)?;
-    let all: Vec<usize> = (0..mesh.element_count()).collect();
-    let body = Body::fill_simplices(&mesh, &all, SimplexRule::Keast11);
-    let set = |name: &str| -> Result<Vec<usize>, SolverError> {
-        mesh.node_sets()
-            .get(name)
-            .map(<[usize]>::to_vec)
-            .ok_or_else(|| SolverError::InvalidInput(format!("the mesh has no node set `{name}`")))
+    let output = crate::scene::run(problem, control, observer)?;
+    let elements = match &problem.mesh {
+        crate::scene::build::SceneMesh::Simplex(m) => m.element_count(),
+        crate::scene::build::SceneMesh::Grid(_) => 0,
     };
-    let mut rollers = NodalConstraints::<3>::new(mesh.node_count());
-    for (axis, name) in ["x0", "y0", "z0"].into_iter().enumerate() {
-        rollers.fix(set(name)?, axis);
-    }
-    let motion = Stretch {
-        axis: 1,
-        origin: 0.0,
-        length: p.size,
-        extension: p.stretch,
-    };
-    let constraints = MovingMesh::new(
-        rollers,
-        motion,
-        mesh.nodes().to_vec(),
-        &set("y1")?,
-        [p.clamped_top, true, p.clamped_top],
-    );
-    let law = VonMises::new(
-        p.youngs_modulus,
-        p.poisson_ratio,
-        p.yield_stress,
-        p.hardening,
-    )
-    .map_err(SolverError::from)?;
-    let elements = mesh.element_count();
-    let setup = Setup {
-        grid: mesh,
-        body: &body,
-        density: 0.0,
-        law,
-        loads: Loads::default(),
-        constraints,
-        stepping: LoadStepping::uniform(p.load_steps),
-        newton: NewtonOptions {
-            tolerance: p.tolerance,
-            predictor: p.predictor,
-            ..NewtonOptions::default()
-        },
-    };
-    let output = simulate::<3, LinearSimplex, F, NoUpdate, _, _, _>(
-        setup,
-        LinearSimplex,
-        NoUpdate,
-        control,
-        observer,
-    )?;
+    let body = problem;
     let tau_a = p.analytic_stress();
     let taus: Vec<f64> = output
         .last
@@ -286,7 +279,7 @@ where
         error,
         analytic_stress: tau_a,
         tau_yy: (mean, lo, hi),
-        material_points: body.len(),
+        material_points: problem.len(),
         elements,
     })
 }

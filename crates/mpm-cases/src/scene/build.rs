@@ -431,7 +431,116 @@ impl<const D: usize> Problem<D> {
 
         // Mesh.
         let m = &scene.mesh;
+        let annulus_key = [
+            m.inner_radius.as_ref().map(Spanned::span),
+            m.outer_radius.as_ref().map(Spanned::span),
+            m.layers.as_ref().map(Spanned::span),
+            m.ring_nodes.as_ref().map(Spanned::span),
+            m.jitter.as_ref().map(Spanned::span),
+            m.seed.as_ref().map(Spanned::span),
+        ]
+        .into_iter()
+        .flatten()
+        .next();
+        if m.kind != MeshKind::Annulus
+            && let Some(span) = annulus_key
+        {
+            return Err(src.error(Some(span), "`inner_radius`, `outer_radius`, `layers`, `ring_nodes`, `jitter` and `seed` apply to kind = \"annulus\" meshes"));
+        }
         let (mesh, origin, upper, padding) = match m.kind {
+            MeshKind::Annulus => {
+                let misplaced = [
+                    m.origin.as_ref().map(Spanned::span),
+                    m.size.as_ref().map(Spanned::span),
+                    m.cells.as_ref().map(Spanned::span),
+                    m.spacing.as_ref().map(Spanned::span),
+                    m.padding.as_ref().map(Spanned::span),
+                    m.file.as_ref().map(Spanned::span),
+                    m.dimension.as_ref().map(Spanned::span),
+                    m.patches.as_ref().map(Spanned::span),
+                ];
+                if let Some(span) = misplaced.into_iter().flatten().next() {
+                    return Err(src.error(Some(span), "an annulus mesh takes `inner_radius`, `outer_radius`, `layers`, `ring_nodes`, `jitter` and `seed`"));
+                }
+                if D != 2 {
+                    return Err(src.error(None, "an annulus mesh is 2D"));
+                }
+                let (Some(ri), Some(ro), Some(layers), Some(ring)) =
+                    (&m.inner_radius, &m.outer_radius, &m.layers, &m.ring_nodes)
+                else {
+                    return Err(src.error(
+                        None,
+                        "[mesh]: an annulus needs `inner_radius`, `outer_radius`, `layers` and `ring_nodes`",
+                    ));
+                };
+                let (a, b) = (*ri.get_ref(), *ro.get_ref());
+                if !(a > 0.0 && b > a && b.is_finite()) {
+                    return Err(src.at(
+                        ri,
+                        format!(
+                            "an annulus needs 0 < inner_radius < outer_radius, got {a} and {b}"
+                        ),
+                    ));
+                }
+                let layers = check.at_least(layers, 1, "mesh `layers`")?;
+                let ring = check.at_least(ring, 3, "mesh `ring_nodes`")?;
+                if layers.saturating_add(1).saturating_mul(ring) > MAX_ENTITIES {
+                    return Err(src.error(
+                        None,
+                        &format!("the annulus would have more than {MAX_ENTITIES} nodes"),
+                    ));
+                }
+                let jitter = match &m.jitter {
+                    Some(j) if !(0.0..=mpm_mesh::AnnulusMesh::MAX_JITTER).contains(j.get_ref()) => {
+                        return Err(src.at(
+                            j,
+                            format!(
+                                "`jitter` must lie in [0, {}]",
+                                mpm_mesh::AnnulusMesh::MAX_JITTER
+                            ),
+                        ));
+                    }
+                    Some(j) => *j.get_ref(),
+                    None => 0.0,
+                };
+                let seed = m.seed.as_ref().map_or(1, |s| *s.get_ref());
+                if let Err(reason) = variant.require_standard_mpm("an annulus mesh") {
+                    return Err(src.at(ri, reason));
+                }
+                let mesh_error = |e: mpm_mesh::MeshError| src.at(ri, format!("mesh: {e}"));
+                let ring_mesh = mpm_mesh::AnnulusMesh::new(a, b, layers, ring)
+                    .with_jitter(jitter, seed)
+                    .simplex_mesh()
+                    .map_err(mesh_error)?;
+                // The same mesh in the scene's dimension (which is 2).
+                let nodes = ring_mesh
+                    .nodes()
+                    .iter()
+                    .map(|x| SVector::<f64, D>::from_fn(|i, _| x[i]))
+                    .collect();
+                let mut simplices = SimplexMesh::<D>::new(nodes, ring_mesh.connectivity().to_vec())
+                    .map_err(mesh_error)?;
+                for (name, ids) in ring_mesh.node_sets().iter() {
+                    simplices
+                        .sets_mut()
+                        .insert_nodes(name, ids.to_vec())
+                        .map_err(mesh_error)?;
+                }
+                // Its triangles form the group `domain`, as in the Gmsh
+                // annulus files.
+                let all = (0..simplices.element_count()).collect();
+                simplices
+                    .sets_mut()
+                    .insert_elements("domain", all)
+                    .map_err(mesh_error)?;
+                let bb = *simplices.bounding_box();
+                (
+                    SceneMesh::Simplex(Box::new(simplices)),
+                    bb.lower,
+                    bb.upper,
+                    0,
+                )
+            }
             MeshKind::Grid => {
                 if let Some(f) = m.file.as_ref() {
                     return Err(src.at(f, "`file` applies to kind = \"gmsh\" meshes"));

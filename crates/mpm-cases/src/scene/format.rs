@@ -58,6 +58,10 @@ pub enum MeshKind {
     /// A Gmsh MSH 4.1 file of triangles or tetrahedra (linear, or
     /// quadratic split into their linear children).
     Gmsh,
+    /// A 2D annulus about the origin of linear triangles: `layers` rings of
+    /// elements between `inner_radius` and `outer_radius`, `ring_nodes`
+    /// nodes per ring, optionally jittered.
+    Annulus,
     /// The box `origin .. origin + size` of `cells` squares or cubes, each
     /// split into triangles or tetrahedra (or into six-node triangles or
     /// ten-node tetrahedra split into their linear children, `patches`).
@@ -99,6 +103,25 @@ pub struct MeshSpec {
     /// false: linear simplices).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub patches: Option<Spanned<bool>>,
+    /// Annulus: inner radius (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inner_radius: Option<Spanned<f64>>,
+    /// Annulus: outer radius (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outer_radius: Option<Spanned<f64>>,
+    /// Annulus: element layers across the thickness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layers: Option<Spanned<usize>>,
+    /// Annulus: nodes per ring.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ring_nodes: Option<Spanned<usize>>,
+    /// Annulus: jitter of the interior nodes, a fraction (at most 0.2) of
+    /// the radial and angular steps (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jitter: Option<Spanned<f64>>,
+    /// Annulus: seed of the jitter (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<Spanned<u64>>,
     /// The mesh moves with the load factor (moving-mesh conditions).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motion: Option<MotionSpec>,

@@ -93,6 +93,7 @@ pub fn parse(
 pub fn dimension(scene: &Scene, source: &SceneSource) -> Result<usize, CasesError> {
     let m = &scene.mesh;
     let (d, at) = match (m.kind, &m.origin, &m.dimension) {
+        (format::MeshKind::Annulus, _, _) => return Ok(2),
         (format::MeshKind::Grid | format::MeshKind::Simplex, Some(origin), _) => {
             (origin.get_ref().len(), origin.span())
         }
