@@ -117,7 +117,9 @@ pub struct CantileverResult {
 /// node on x = 0 on a roller, so that GIMP and CPDI2 corners near the root
 /// stay on it; padding nodes beyond it free) with its neutral-axis node
 /// pinned; the end load shared by the two points of the last lattice
-/// column that straddle the neutral axis.
+/// column that straddle the neutral axis. The points' lattice is anchored
+/// at the beam's corner, not at the grid's origin 10 m below, so that
+/// their coordinates are (i + ½)·h/n exactly as the beam's own lattice.
 ///
 /// # Errors
 /// [`SolverError::InvalidInput`] unless `h` divides half the depth and the
@@ -146,7 +148,7 @@ pub fn scene_text(p: &CantileverParams, variant: &Variant) -> Result<String, Sol
     Ok(format!(
         "[mesh]\norigin = [0.0, {oy:?}]\nsize = [{sx:?}, {sy:?}]\ncells = [{cx}, {cy}]\n\n\
          [[material]]\nname = \"beam\"\nmodel = \"hencky\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\n\n\
-         [[body]]\nname = \"beam\"\nmaterial = \"beam\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [{l:?}, {d:?}] }} }}\npoints_per_cell = {ppc}\n\n\
+         [[body]]\nname = \"beam\"\nmaterial = \"beam\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [{l:?}, {d:?}] }} }}\npoints_per_cell = {ppc}\nlattice_origin = [0.0, 0.0]\n\n\
          [[node_set]]\nname = \"root\"\nregion = {{ box = {{ lower = [{mt:?}, {y_lo:?}], upper = [{tol:?}, {y_hi:?}] }} }}\n\n\
          [[node_set]]\nname = \"neutral_axis_at_root\"\nregion = {{ box = {{ lower = [{mt:?}, {na_lo:?}], upper = [{tol:?}, {na_hi:?}] }} }}\n\n\
          [[boundary]]\nset = \"root\"\nkind = \"displacement\"\ndisplacement = {{ x = 0.0 }}\n\n\
