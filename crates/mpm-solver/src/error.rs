@@ -148,6 +148,33 @@ pub enum SolverError {
     /// last converged step is intact.
     #[error("output or observer after a converged step: {0}")]
     Observer(#[source] ObserverError),
+    /// The locking treatment could not place the points in patches.
+    #[error("locking treatment: {0}")]
+    Locking(#[from] LockingError),
+}
+
+/// Why a locking treatment could not place the points in patches
+/// ([`crate::LockingTreatment::assign`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum LockingError {
+    /// A point lies in no cell of the mesh.
+    #[error("material point {point} at {position:?} lies in no cell of the mesh")]
+    OutsideMesh {
+        /// Index of the material point.
+        point: usize,
+        /// Its position.
+        position: Vec<f64>,
+    },
+    /// The patch map does not match the mesh.
+    #[error(
+        "the patch map has {entries} entries for a mesh of {elements} elements (F-patch needs the children mesh of its patch mesh)"
+    )]
+    PatchMap {
+        /// Entries of the map.
+        entries: usize,
+        /// Elements of the mesh.
+        elements: usize,
+    },
 }
 
 /// What went wrong evaluating a material point's basis.

@@ -35,6 +35,15 @@ pub trait Formulation: Copy + Default + Send + Sync + 'static {
         r: &Response<H>,
         g: &SVector<f64, D>,
     ) -> SVector<f64, D>;
+
+    /// The direction $K$ in which a uniform dilatation $\delta\epsilon$
+    /// changes the kinematic variable the tangent is the derivative with
+    /// respect to: $\delta\Delta F\,\Delta F^{-1} = \delta\epsilon\,\mathbf
+    /// 1$ gives $\mathbf 1$ for the spatial tangent and $\delta\Delta F =
+    /// \delta\epsilon\,\Delta F$ for the previously converged one. The patch
+    /// coupling of locking treatments contracts the tangent with it
+    /// ([`crate::stages::patch`]).
+    fn volumetric_direction<H: Copy>(r: &Response<H>) -> Matrix3<f64>;
 }
 
 /// Updated Lagrangian formulation (Coombs 2020 §3, eqs. 2–9): equilibrium in
@@ -65,6 +74,11 @@ impl Formulation for UpdatedLagrangian {
     ) -> SVector<f64, D> {
         SVector::<f64, D>::from_fn(|j, _| (0..D).map(|i| g[i] * r.delta_f_inv[(i, j)]).sum())
     }
+
+    #[inline]
+    fn volumetric_direction<H: Copy>(_r: &Response<H>) -> Matrix3<f64> {
+        Matrix3::identity()
+    }
 }
 
 /// Previously converged formulation (Coombs 2020 §5, eqs. 13–23):
@@ -94,5 +108,10 @@ impl Formulation for PreviouslyConverged {
         g: &SVector<f64, D>,
     ) -> SVector<f64, D> {
         *g
+    }
+
+    #[inline]
+    fn volumetric_direction<H: Copy>(r: &Response<H>) -> Matrix3<f64> {
+        r.delta_f
     }
 }

@@ -8,7 +8,7 @@
 //! | `mpm_basis::BasisFunction` | `LinearMpm`, `Gimp`, `Cpdi2`, `QuadraticBSpline`, `LinearSimplex` | Coombs et al. 2020 §6.1; Wang et al. 2021 §2.3 |
 //! | `mpm_constitutive::LogStrainLaw` | `HenckyElastic`, `VonMises` | Coombs et al. 2020 §2 |
 //! | [`Formulation`] | [`UpdatedLagrangian`], [`PreviouslyConverged`] | §3, §5 |
-//! | [`LockingTreatment`] | [`NoLocking`] (F-bar, F-patch, cell-averaged dilatation to come) | Wang et al. 2021 §3.2 |
+//! | [`LockingTreatment`] | [`NoLocking`], [`FBar`], [`FPatch`] | Wang et al. 2021 §3.2; Coombs et al. 2018 |
 //! | [`DomainUpdater`] (or the shorter [`DeformationRule`]) | [`NoUpdate`], [`DetF`], [`DiagF`], [`StretchU`], [`CornerMidpoint`], [`Midpoint`], [`VolumeCorrectedDiagF`], [`IncrementalVolumeCorrectedDiagF`], [`ConvectedCorners`], [`DomainVolume`] | Coombs et al. 2020 §6.4 |
 //! | [`Constraints`] | [`NodalConstraints`], [`MovingMesh`] | §6.2; Wang et al. 2021 §5.3 |
 //! | [`LinearSolver`] | [`FaerDirect`] | eq. 26 |
@@ -85,13 +85,15 @@ pub use domain::{
     DomainContext, DomainError, DomainUpdater, DomainVolume, GimpContext,
     IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, StretchU, VolumeCorrectedDiagF,
 };
-pub use error::{BasisFailure, MeshMotionError, ObserverError, SolverError, StepFailure};
+pub use error::{
+    BasisFailure, LockingError, MeshMotionError, ObserverError, SolverError, StepFailure,
+};
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
 pub use implicit::{
     FreeStiffness, ImplicitBuilder, ImplicitSolver, NewtonOptions, StepError, StepReport,
 };
 pub use linear::{Factorisation, FaerDirect, LinearSolveError, LinearSolver};
-pub use locking::{LockingTreatment, NoLocking};
+pub use locking::{FBar, FPatch, LockingTreatment, NoLocking, PatchAssignment, PatchInput};
 pub use mesh::{MovableMesh, NodalMesh};
 pub use moving_mesh::{MeshMotion, MovingMesh, Rotation, Stretch, Translation};
 pub use parts::{Parts, PointsOf, SolverParts};

@@ -40,7 +40,7 @@ pub trait SolverParts<const D: usize> {
     /// The law's internal variables (`()` for elasticity).
     type History: Copy + Default + Debug + PartialEq + Send + Sync + 'static;
     /// Locking treatment.
-    type Locking: LockingTreatment;
+    type Locking: LockingTreatment<D, Self::Mesh>;
     /// Domain update rule.
     type Updater: DomainUpdater<D, Self::Domain>;
     /// Dirichlet conditions (and the mesh motion).
@@ -57,7 +57,7 @@ where
     B::Mesh: MovableMesh<D>,
     F: Formulation,
     L: LogStrainLaw,
-    K: LockingTreatment,
+    K: LockingTreatment<D, B::Mesh>,
     U: DomainUpdater<D, B::Domain>,
     C: Constraints<D>,
 {

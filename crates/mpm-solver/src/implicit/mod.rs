@@ -50,6 +50,7 @@ use crate::error::StepFailure;
 use crate::linear::{FaerDirect, LinearSolver};
 use crate::parts::{PointsOf, SolverParts};
 use crate::stages::convergence::{self, NewtonMonitor, Verdict};
+use crate::stages::patch::PatchSystem;
 use crate::stages::system::StepSystem;
 
 /// Per-iteration buffers, sized once per step.
@@ -65,7 +66,6 @@ struct Iterate<const D: usize, H> {
     tangent_w: Vec<Tensor4>,
     mapped: Vec<SVector<f64, D>>,
     increments: Vec<Matrix3<f64>>,
-    volumes: Vec<f64>,
     /// `values` holds a stiffness assembled on the current system.
     stiffness_assembled: bool,
 }
@@ -83,7 +83,6 @@ impl<const D: usize, H> Default for Iterate<D, H> {
             tangent_w: Vec::new(),
             mapped: Vec::new(),
             increments: Vec::new(),
-            volumes: Vec::new(),
             stiffness_assembled: false,
         }
     }
@@ -116,6 +115,8 @@ pub struct ImplicitSolver<const D: usize, P: SolverParts<D>> {
     /// `linear` holds the analysed pattern of the current system.
     analysed: bool,
     system: StepSystem<D>,
+    /// The patches of a coupled locking treatment (empty otherwise).
+    patches: PatchSystem<D>,
     it: Iterate<D, P::History>,
     /// The last converged increment per mesh dof and its load increment.
     previous: Option<(Vec<f64>, f64)>,
@@ -151,6 +152,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             linear: Box::new(FaerDirect::default()),
             analysed: false,
             system: StepSystem::default(),
+            patches: PatchSystem::default(),
             it: Iterate::default(),
             previous: None,
             hints: Vec::new(),

@@ -3,8 +3,8 @@
 //! [`crate::stages`], plus the constitutive update and tangents, which
 //! depend on the formulation.
 
-use mpm_constitutive::tensor::Tensor4;
-use mpm_constitutive::{ConsistentTangent, LogStrainLaw, MaterialState, update};
+use mpm_constitutive::tensor::{Tensor4, idx};
+use mpm_constitutive::{ConsistentTangent, ConstitutiveError, LogStrainLaw, MaterialState, update};
 use nalgebra::{Matrix3, SVector};
 use rayon::prelude::*;
 
@@ -13,7 +13,7 @@ use crate::boundary::{Constraints, StepView};
 use crate::error::{SolverError, StepFailure};
 use crate::formulation::Formulation;
 use crate::linear::LinearSolveError;
-use crate::locking::LockingTreatment;
+use crate::locking::{LockingTreatment, PatchInput};
 use crate::mesh::NodalMesh;
 use crate::parts::{PointsOf, SolverParts};
 use crate::stages::system::NONE;
@@ -56,19 +56,33 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         )
     }
 
-    /// Stage 2: active nodes, dofs, prescribed increments, adjacency,
-    /// sparsity pattern and the symbolic factorisation.
+    /// Stage 2: active nodes, dofs, prescribed increments, adjacency, the
+    /// patches of a coupled locking treatment, sparsity pattern and the
+    /// symbolic factorisation.
     pub fn build_system(
         &mut self,
-        volumes: &[f64],
+        points: &PointsOf<D, P>,
         lambda0: f64,
         lambda1: f64,
     ) -> Result<(), SolverError> {
         let node_count = self.mesh.node_count();
+        let volumes = &points.volume;
         let sys = &mut self.system;
         sys.number_nodes(node_count);
         sys.build_adjacency();
-        sys.build_neighbours();
+        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+            let input = PatchInput {
+                position: &points.position,
+                cells: &self.hints,
+                volume: volumes,
+            };
+            self.locking
+                .assign(&self.mesh, input, &mut self.patches.assignment)?;
+            self.patches.build(sys);
+            sys.build_patch_neighbours(&self.patches);
+        } else {
+            sys.build_neighbours();
+        }
         let (support, stiffness) = gather::support_weights(sys, volumes);
         let max = |x: &[f64]| x.iter().copied().fold(0.0, f64::max);
         let (support_cut, stiffness_cut) = (
@@ -102,7 +116,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         it.values.resize(sys.row_idx.len(), 0.0);
         it.stiffness_assembled = false;
         let symmetric = <P::Law as LogStrainLaw>::SYMMETRIC_TANGENT
-            && !<P::Locking as LockingTreatment>::COUPLES_POINTS;
+            && !<P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS;
         self.analysed = false;
         self.linear
             .analyse(sys.n_free, &sys.col_ptr, &sys.row_idx, symmetric)
@@ -166,17 +180,24 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             it.mapped.resize(sys.grads.len(), SVector::zeros());
         }
         let du = &it.du;
-        if <P::Locking as LockingTreatment>::COUPLES_POINTS {
+        let coupled = <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS;
+        if coupled {
             it.increments.resize(n, Matrix3::identity());
             it.increments
                 .par_iter_mut()
                 .enumerate()
                 .for_each(|(p, m)| *m = grid_to_point::deformation_increment(sys, du, p));
-            it.volumes.clear();
-            it.volumes.extend_from_slice(&points.volume);
-            self.locking.prepare(&it.increments, &it.volumes);
+            self.patches
+                .average(&it.increments)
+                .map_err(|e| StepFailure::Constitutive {
+                    point: e.point,
+                    source: ConstitutiveError::NonPositiveJacobian {
+                        which: "ΔF",
+                        det: e.det,
+                    },
+                })?;
         }
-        let (law, locking) = (&self.law, &self.locking);
+        let (law, patches, increments) = (&self.law, &self.patches, &it.increments);
         let limit = self.options.max_increment_norm;
         let stride = sys.stride;
         let mapped_chunks = it.mapped.par_chunks_mut(stride.max(1));
@@ -186,8 +207,13 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             .zip(it.stress_w.par_iter_mut())
             .enumerate()
             .map(|(p, (response, stress))| {
-                let delta_f = locking
-                    .modified_increment(p, &grid_to_point::deformation_increment(sys, du, p));
+                // The motion's ΔF (eq. 7), or the patch-averaged ΔF̄ the
+                // law sees under a coupled treatment (Wang et al. eq. 9).
+                let delta_f = if coupled {
+                    patches.modified(p, &increments[p])
+                } else {
+                    grid_to_point::deformation_increment(sys, du, p)
+                };
                 let state = MaterialState {
                     be: points.be[p],
                     history: points.history[p],
@@ -289,7 +315,62 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                     }
                 }
                 Ok(())
-            })
+            })?;
+        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+            self.patch_tangents();
+        }
+        Ok(())
+    }
+
+    /// The coupled part of the tangent ([`crate::stages::patch`]): the
+    /// motion's spatial gradients and their patch averages, $\mathbf
+    /// h_{vp} = B_p\nabla S_{vp}$ with $B_p = \tfrac1D T_p : K_p$, and the
+    /// point tangents scaled by $\alpha_p$ for the standard kernel.
+    fn patch_tangents(&mut self) {
+        let it = &mut self.it;
+        let responses = &it.responses;
+        let patches = &mut self.patches;
+        patches.gradients(&self.system, |p| {
+            responses[p]
+                .as_ref()
+                .map_or_else(Matrix3::identity, |r| r.delta_f_inv)
+        });
+        let sys = &self.system;
+        let grads: &[SVector<f64, D>] = if <P::Formulation as Formulation>::MAPS_GRADIENTS {
+            &it.mapped
+        } else {
+            &sys.grads
+        };
+        let stride = sys.stride.max(1);
+        let alpha = &patches.alpha;
+        patches
+            .h
+            .par_chunks_mut(stride)
+            .zip(it.tangent_w.par_iter_mut())
+            .enumerate()
+            .for_each(|(p, (h, t))| {
+                let Some(r) = &responses[p] else {
+                    return;
+                };
+                let k = P::Formulation::volumetric_direction(r);
+                let mut b = [[0.0f64; D]; D];
+                for (i, row) in b.iter_mut().enumerate() {
+                    for (j, bij) in row.iter_mut().enumerate() {
+                        let mut acc = 0.0;
+                        for a in 0..D {
+                            for c in 0..D {
+                                acc += t[(idx(i, j), idx(a, c))] * k[(a, c)];
+                            }
+                        }
+                        *bij = acc / D as f64;
+                    }
+                }
+                for (slot, hv) in h.iter_mut().take(sys.counts[p] as usize).enumerate() {
+                    let g = &grads[p * stride + slot];
+                    *hv = SVector::<f64, D>::from_fn(|i, _| (0..D).map(|j| b[i][j] * g[j]).sum());
+                }
+                *t *= alpha[p];
+            });
     }
 
     /// Stage 4d: the stiffness (eqs. 4/21, 27) in CSC over free dofs
@@ -302,6 +383,9 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             &self.it.tangent_w,
             &mut values,
         );
+        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+            gather::patch_coupling(&self.system, &self.patches, &mut values);
+        }
         self.it.values = values;
         self.it.stiffness_assembled = true;
     }

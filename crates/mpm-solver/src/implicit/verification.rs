@@ -23,7 +23,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         self.move_mesh(lambda0)?;
         self.evaluate_basis(points)?;
         self.begin_constraints(points);
-        self.build_system(&points.volume, lambda0, lambda1)?;
+        self.build_system(points, lambda0, lambda1)?;
         self.assemble_external_force(points, lambda1);
         Ok(self.system.n_free)
     }

@@ -11,6 +11,7 @@ use nalgebra::{Matrix3, SVector};
 use rayon::prelude::*;
 
 use crate::points::MaterialPoints;
+use crate::stages::patch::PatchSystem;
 use crate::stages::system::{NONE, NOT_A_NEIGHBOUR, PARTIAL, StepSystem};
 
 /// Lumped nodal mass $m_v = \sum_p S_{vp} m_p$ per active node (MPoint
@@ -165,6 +166,47 @@ pub fn stiffness<const D: usize>(
                     continue;
                 }
                 scatter_wide(rows, gv, &q, vals);
+            }
+        }
+    };
+    split_blocks(0, sys.n_active(), values, 0, &sys.block_ptr, &block);
+}
+
+/// Adds the patch coupling of a locking treatment to a stiffness
+/// assembled by [`stiffness`]: $K_{(vi)(wk)} \mathrel{+}= \sum_p
+/// h_{vp,i}\,(\mathbf G_{wP} - \mathbf g_{wp})_k$ over the points $p$ of
+/// every patch $P$ whose node union holds $w$ ([`PatchSystem`]; the
+/// pattern must be the patch pattern of
+/// [`StepSystem::build_patch_neighbours`]). One block column per task,
+/// patches and points ascending, so the sums do not depend on the thread
+/// count.
+pub fn patch_coupling<const D: usize>(
+    sys: &StepSystem<D>,
+    patches: &PatchSystem<D>,
+    values: &mut [f64],
+) {
+    let block = |w: usize, vals: &mut [f64]| {
+        let nbs = &sys.nb[sys.nb_ptr[w]..sys.nb_ptr[w + 1]];
+        let map = &sys.block_map[sys.nb_ptr[w] * D * D..sys.nb_ptr[w + 1] * D * D];
+        for &(k, u) in &patches.node_patches[patches.node_ptr[w]..patches.node_ptr[w + 1]] {
+            for &p in patches.members_of(k as usize) {
+                let p = p as usize;
+                let c = patches.column(sys, p, u);
+                for s in sys.slots(p) {
+                    let Ok(pos) = nbs.binary_search(&sys.nodes[s]) else {
+                        continue;
+                    };
+                    let rows = &map[pos * D * D..(pos + 1) * D * D];
+                    let h = &patches.h[s];
+                    for i in 0..D {
+                        for kk in 0..D {
+                            let off = rows[i * D + kk];
+                            if off != NONE {
+                                vals[off as usize] += h[i] * c[kk];
+                            }
+                        }
+                    }
+                }
             }
         }
     };

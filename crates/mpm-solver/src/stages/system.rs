@@ -6,6 +6,8 @@
 
 use nalgebra::SVector;
 
+use crate::stages::patch::PatchSystem;
+
 /// Marker for "none" in the `u32` index maps.
 pub const NONE: u32 = u32::MAX;
 
@@ -165,6 +167,32 @@ impl<const D: usize> StepSystem<D> {
             for &(p, _) in &self.adj[self.adj_ptr[w]..self.adj_ptr[w + 1]] {
                 for s in self.slots(p as usize) {
                     let v = self.nodes[s];
+                    if mark[v as usize] != w as u32 {
+                        mark[v as usize] = w as u32;
+                        row.push(v);
+                    }
+                }
+            }
+            row.sort_unstable();
+            self.nb.extend_from_slice(&row);
+            self.nb_ptr.push(self.nb.len());
+        }
+    }
+
+    /// Sorted neighbour lists of a patch-coupled step: nodes sharing a
+    /// patch (a superset of the nodes sharing a point, since a patch's
+    /// union holds its points' stencils).
+    pub fn build_patch_neighbours(&mut self, patches: &PatchSystem<D>) {
+        let n = self.n_active();
+        let mut mark = vec![NONE; n];
+        let mut row: Vec<u32> = Vec::with_capacity(64);
+        self.nb_ptr.clear();
+        self.nb_ptr.push(0);
+        self.nb.clear();
+        for w in 0..n {
+            row.clear();
+            for &(k, _) in &patches.node_patches[patches.node_ptr[w]..patches.node_ptr[w + 1]] {
+                for &v in patches.union_of(k as usize) {
                     if mark[v as usize] != w as u32 {
                         mark[v as usize] = w as u32;
                         row.push(v);
