@@ -14,6 +14,9 @@
 //!   moving mesh (Table 1, standard MPM) and point location by walking
 //!   against brute force (§5.7), written to
 //!   `docs/src/reproduction/wang2021.md` ([`wang2021`]).
+//! - `reproduce locking`: Cook's membrane against refinement for standard
+//!   MPM, F-patch and F-bar, written to `docs/src/reproduction/locking.md`
+//!   ([`locking`]).
 //! - `column-table`: error and solver time of the column for standard MPM
 //!   and GIMP (eq. 34), written to `docs/src/benchmarks/column.md`
 //!   ([`column_table`]).
@@ -25,6 +28,7 @@
 
 mod column_table;
 mod coombs2020;
+mod locking;
 mod machine;
 mod markdown;
 mod plot;
@@ -50,6 +54,10 @@ tasks:
                 Wang et al. (2021): simple stretch on tetrahedra (Table 1, standard
                 MPM) and walking point location (§5.7); writes
                 docs/src/reproduction/wang2021.md. --full adds 16 subdivisions.
+  reproduce locking
+                Cook's membrane (plane strain, nu = 0.3 and 0.4999, small and full
+                load) for standard MPM, F-patch and F-bar against refinement;
+                writes docs/src/reproduction/locking.md and its PNG plots.
   column-table  error and run time of the column case, written to
                 docs/src/benchmarks/column.md
   reference-values
@@ -86,7 +94,11 @@ fn main() -> Result<()> {
                 };
                 wang2021::run_report(full, &docs_dir())
             }
-            Some(other) => bail!("unknown paper `{other}`; known: coombs2020, wang2021"),
+            Some("locking") => {
+                no_more_arguments(&args[2..])?;
+                locking::run(&docs_dir())
+            }
+            Some(other) => bail!("unknown paper `{other}`; known: coombs2020, wang2021, locking"),
             None => {
                 bail!("`reproduce` needs a paper: `reproduce coombs2020` or `reproduce wang2021`")
             }

@@ -27,6 +27,7 @@ pub mod body;
 pub mod cases;
 pub mod checkpoint;
 pub mod error;
+pub mod locking;
 pub mod material;
 pub mod output;
 pub mod params;

@@ -5,8 +5,8 @@ use std::time::Instant;
 use mpm_constitutive::{LogStrainLaw, Tagged, VonMisesHistory};
 use mpm_solver::{
     BodyForcePath, Constraints, DomainUpdater, Flat, Formulation, ImplicitSolver, LoadStepping,
-    MaterialPoints, MovableMesh, NewtonOptions, NoLocking, NodalMesh, Parts, RunState, RunSummary,
-    SolverError, StepReport,
+    LockingTreatment, MaterialPoints, MovableMesh, NewtonOptions, NoLocking, NodalMesh, Parts,
+    RunState, RunSummary, SolverError, StepReport,
 };
 use nalgebra::SVector;
 
@@ -285,16 +285,21 @@ where
         stepping: setup.stepping,
         newton: setup.newton,
     };
-    simulate_points::<D, B, F, U, L, C, O>(points, analysis, basis, updater, control, observer)
+    simulate_points::<D, B, F, U, NoLocking, L, C, O>(
+        points, analysis, basis, updater, NoLocking, control, observer,
+    )
 }
 
 /// [`simulate`] from material points the caller has set up (per-point
-/// masses, initial histories such as material tags, loads).
-pub fn simulate_points<const D: usize, B, F, U, L, C, O>(
+/// masses, initial histories such as material tags, loads), with the
+/// locking treatment `locking`.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_points<const D: usize, B, F, U, K, L, C, O>(
     mut points: MaterialPoints<D, L::History, B::Domain>,
     analysis: Analysis<B::Mesh, L, C>,
     basis: B,
     updater: U,
+    locking: K,
     control: &RunControl,
     mut observer: O,
 ) -> Result<RunOutput<D>, SolverError>
@@ -304,6 +309,7 @@ where
     B::Domain: Flat + DomainBounds<D>,
     F: Formulation,
     U: DomainUpdater<D, B::Domain>,
+    K: LockingTreatment<D, B::Mesh>,
     L: LogStrainLaw,
     L::History: HistoryOutput + Flat,
     C: Constraints<D>,
@@ -311,11 +317,11 @@ where
 {
     let setup = analysis;
     let moves_mesh = setup.constraints.moves_mesh();
-    let mut solver: ImplicitSolver<D, Parts<B, F, L, NoLocking, U, C>> = ImplicitSolver::new(
+    let mut solver: ImplicitSolver<D, Parts<B, F, L, K, U, C>> = ImplicitSolver::new(
         basis,
         setup.grid,
         setup.law,
-        NoLocking,
+        locking,
         updater,
         setup.constraints,
         setup.newton,

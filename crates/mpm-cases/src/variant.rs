@@ -152,6 +152,12 @@ named_enum!(
     LockingKind {
         /// Standard: none.
         None => "none",
+        /// F-bar on regular grids: points of a cell share its volumetric
+        /// deformation (`mpm_solver::FBar`).
+        FBar => "fbar",
+        /// F-patch on simplices split from tri6/tet10 parents
+        /// (`mpm_solver::FPatch`, Wang et al. 2021).
+        FPatch => "fpatch",
     }
 );
 
@@ -176,21 +182,34 @@ fn default_gimp_volume() -> GimpVolumeKind {
 }
 
 impl Variant {
-    /// `Ok` for standard MPM without domain update or locking treatment,
-    /// the only variant of the simplex-mesh cases (`mesh` names their mesh
-    /// in the error).
-    pub fn require_standard_mpm(&self, mesh: &str) -> Result<(), String> {
-        if self.basis == BasisKind::Linear
-            && self.domain_update == DomainUpdateKind::None
-            && self.locking == LockingKind::None
-        {
-            Ok(())
-        } else {
-            Err(format!(
-                "on {mesh} the variant is standard MPM: basis = linear, domain_update = none, locking = none (got {} / {} / {})",
-                self.basis, self.domain_update, self.locking
-            ))
+    /// `Ok` for the variants of simplex meshes: linear basis, no domain
+    /// update, and no locking treatment or F-patch when the mesh has
+    /// patches (`patches`: split from quadratic parents); `mesh` names the
+    /// mesh in the error.
+    pub fn require_simplex(&self, mesh: &str, patches: bool) -> Result<(), String> {
+        if self.basis != BasisKind::Linear || self.domain_update != DomainUpdateKind::None {
+            return Err(format!(
+                "on {mesh} the variant is standard MPM: basis = linear, domain_update = none (got {} / {})",
+                self.basis, self.domain_update
+            ));
         }
+        match self.locking {
+            LockingKind::None => Ok(()),
+            LockingKind::FPatch if patches => Ok(()),
+            LockingKind::FPatch => Err(format!(
+                "locking = fpatch needs patches, and {mesh} has none: split quadratic parents with [mesh] patches = true, or read a quadratic (tri6/tet10) Gmsh mesh"
+            )),
+            LockingKind::FBar => Err(format!(
+                "locking = fbar averages over grid cells and applies to regular grids; on {mesh} use locking = fpatch"
+            )),
+        }
+    }
+
+    /// `Ok` for standard MPM without domain update or locking treatment,
+    /// the only variant of the annulus and stretch cases' triangles and
+    /// tetrahedra without patches.
+    pub fn require_standard_mpm(&self, mesh: &str) -> Result<(), String> {
+        self.require_simplex(mesh, false)
     }
 
     /// ` domain-volume` when GIMP points integrate with their domain's
@@ -252,6 +271,22 @@ pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
             "gimp_volume = {} applies to basis = gimp",
             variant.gimp_volume
         ));
+    }
+    match variant.locking {
+        LockingKind::None => {}
+        LockingKind::FPatch => {
+            return Err("locking = fpatch averages over the patches of split tri6/tet10 parents and applies to simplex meshes; on a regular grid use locking = fbar".into());
+        }
+        LockingKind::FBar => {
+            if variant.basis == BasisKind::Cpdi2
+                || !matches!(variant.domain_update, DomainUpdateKind::None)
+            {
+                return Err(format!(
+                    "scenes run locking = fbar with basis = linear, bspline2 or gimp and domain_update = none (got {} / {}); other combinations compose in Rust (mpm_solver::FBar)",
+                    variant.basis, variant.domain_update
+                ));
+            }
+        }
     }
     dispatch_basis(variant, visitor)
 }

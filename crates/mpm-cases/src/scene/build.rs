@@ -292,6 +292,9 @@ pub struct Problem<const D: usize> {
     pub newton: NewtonOptions,
     /// The variant.
     pub variant: Variant,
+    /// The patch (parent element) of every element of a simplex mesh split
+    /// from quadratic parents (for F-patch), `None` otherwise.
+    pub patch_of_element: Option<Vec<usize>>,
     /// Reaction histories: name and the set's mesh nodes (sorted).
     pub reactions: Vec<(String, Vec<usize>)>,
     /// Probes: name and the point nearest the location.
@@ -447,6 +450,7 @@ impl<const D: usize> Problem<D> {
         {
             return Err(src.error(Some(span), "`inner_radius`, `outer_radius`, `layers`, `ring_nodes`, `jitter` and `seed` apply to kind = \"annulus\" meshes"));
         }
+        let mut patch_of_element: Option<Vec<usize>> = None;
         let (mesh, origin, upper, padding) = match m.kind {
             MeshKind::Annulus => {
                 let misplaced = [
@@ -581,18 +585,23 @@ impl<const D: usize> Problem<D> {
                 let Some(file) = &m.file else {
                     return Err(src.error(None, "[mesh]: a Gmsh mesh needs `file` and `dimension`"));
                 };
-                if let Err(reason) = variant.require_standard_mpm("a Gmsh mesh") {
-                    return Err(src.at(file, reason));
-                }
                 let path = mesh_dir.join(file.get_ref());
                 let read = mpm_mesh::read_msh::<D>(&path)
                     .map_err(|e| src.at(file, format!("{}: {e}", path.display())))?;
                 let simplices = match read.elements {
                     mpm_mesh::GmshElements::Linear(mesh) => mesh,
-                    mpm_mesh::GmshElements::Quadratic(q) => mpm_mesh::PatchMesh::from_parents(&q)
-                        .map_err(|e| src.at(file, format!("{}: {e}", path.display())))?
-                        .into_mesh(),
+                    mpm_mesh::GmshElements::Quadratic(q) => {
+                        let split = mpm_mesh::PatchMesh::from_parents(&q)
+                            .map_err(|e| src.at(file, format!("{}: {e}", path.display())))?;
+                        patch_of_element = Some(split.patch_of_element().to_vec());
+                        split.into_mesh()
+                    }
                 };
+                if let Err(reason) =
+                    variant.require_simplex("a Gmsh mesh", patch_of_element.is_some())
+                {
+                    return Err(src.at(file, reason));
+                }
                 let b = *simplices.bounding_box();
                 (SceneMesh::Simplex(Box::new(simplices)), b.lower, b.upper, 0)
             }
@@ -611,17 +620,20 @@ impl<const D: usize> Problem<D> {
                         "[mesh]: a simplex box needs `origin`, `size` and `cells` or `spacing`",
                     ));
                 };
-                if let Err(reason) = variant.require_standard_mpm("a simplex mesh") {
+                let patches = m.patches.as_ref().is_some_and(|p| *p.get_ref());
+                if let Err(reason) = variant.require_simplex("a simplex mesh", patches) {
                     return Err(src.at(origin, format!("[mesh] kind = \"simplex\": {reason}")));
                 }
                 let (grid, origin_v, upper, _) = grid_mesh::<D>(m, origin, size, 0, &variant, src)?;
                 let boxed = mpm_mesh::BoxMesh::new(origin_v, upper, grid.cells_per_axis());
-                let patches = m.patches.as_ref().is_some_and(|p| *p.get_ref());
                 let simplices = if patches {
                     boxed
                         .quadratic_mesh()
                         .and_then(|q| mpm_mesh::PatchMesh::from_parents(&q))
-                        .map(mpm_mesh::PatchMesh::into_mesh)
+                        .map(|split| {
+                            patch_of_element = Some(split.patch_of_element().to_vec());
+                            split.into_mesh()
+                        })
                 } else {
                     boxed.simplex_mesh()
                 }
@@ -1512,6 +1524,7 @@ impl<const D: usize> Problem<D> {
                 ..NewtonOptions::default()
             },
             variant,
+            patch_of_element,
             reactions,
             probes,
             every,

@@ -9,8 +9,9 @@ use mpm_basis::LinearSimplex;
 use mpm_constitutive::LogStrainLaw;
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    BodyForcePath, DomainUpdater, Flat, Formulation, MaterialPoints, MovableMesh, NoUpdate,
-    PreviouslyConverged, SolverError, StepReport, UpdatedLagrangian,
+    BodyForcePath, DomainUpdater, FBar, FPatch, Flat, Formulation, LockingTreatment,
+    MaterialPoints, MovableMesh, NoLocking, NoUpdate, PreviouslyConverged, SolverError, StepReport,
+    UpdatedLagrangian,
 };
 use nalgebra::SVector;
 
@@ -19,7 +20,7 @@ use crate::material::{LawVisitor, MaterialTag, dispatch_law, dispatch_law_set};
 use crate::run::{
     Analysis, DomainBounds, HistoryOutput, RunControl, RunOutput, Snapshot, simulate_points,
 };
-use crate::variant::{FormulationKind, VariantVisitor, dispatch};
+use crate::variant::{FormulationKind, LockingKind, VariantVisitor, dispatch};
 
 use super::build::{Problem, SceneMesh};
 
@@ -51,7 +52,7 @@ where
         SceneMesh::Simplex(mesh) => {
             problem
                 .variant
-                .require_standard_mpm("a simplex mesh")
+                .require_simplex("a simplex mesh", problem.patch_of_element.is_some())
                 .map_err(SolverError::InvalidInput)?;
             let run = WithVariant {
                 problem,
@@ -59,13 +60,37 @@ where
                 control,
                 observer,
             };
-            match problem.variant.formulation {
-                FormulationKind::Pc => {
-                    run.with::<LinearSimplex, PreviouslyConverged, _>(LinearSimplex, NoUpdate)
+            let (pc, patches) = (
+                problem.variant.formulation == FormulationKind::Pc,
+                problem.patch_of_element.as_ref(),
+            );
+            match (problem.variant.locking, patches) {
+                (LockingKind::FPatch, Some(map)) => {
+                    let fpatch = FPatch::from_patch_map(map.clone());
+                    if pc {
+                        run.with::<LinearSimplex, PreviouslyConverged, _, _>(
+                            LinearSimplex,
+                            NoUpdate,
+                            fpatch,
+                        )
+                    } else {
+                        run.with::<LinearSimplex, UpdatedLagrangian, _, _>(
+                            LinearSimplex,
+                            NoUpdate,
+                            fpatch,
+                        )
+                    }
                 }
-                FormulationKind::Ul => {
-                    run.with::<LinearSimplex, UpdatedLagrangian, _>(LinearSimplex, NoUpdate)
-                }
+                _ if pc => run.with::<LinearSimplex, PreviouslyConverged, _, _>(
+                    LinearSimplex,
+                    NoUpdate,
+                    NoLocking,
+                ),
+                _ => run.with::<LinearSimplex, UpdatedLagrangian, _, _>(
+                    LinearSimplex,
+                    NoUpdate,
+                    NoLocking,
+                ),
             }
         }
     }
@@ -90,7 +115,11 @@ where
         F: Formulation,
         U: DomainUpdater<D, B::Domain>,
     {
-        self.with::<B, F, U>(basis, updater)
+        match self.problem.variant.locking {
+            // `dispatch` lets F-bar through with domain_update = none only.
+            LockingKind::FBar => self.with::<B, F, NoUpdate, _>(basis, NoUpdate, FBar::default()),
+            _ => self.with::<B, F, U, _>(basis, updater, NoLocking),
+        }
     }
 }
 
@@ -99,20 +128,22 @@ where
     M: MovableMesh<D> + Clone,
     O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
-    /// Runs with basis `B` (on mesh `M`), formulation `F`, updater `U` and
-    /// the scene's materials.
-    fn with<B, F, U>(self, basis: B, updater: U) -> Result<RunOutput<D>, SolverError>
+    /// Runs with basis `B` (on mesh `M`), formulation `F`, updater `U`,
+    /// locking treatment `K` and the scene's materials.
+    fn with<B, F, U, K>(self, basis: B, updater: U, locking: K) -> Result<RunOutput<D>, SolverError>
     where
         B: InitialDomain<D, Mesh = M, Domain: Flat + DomainBounds<D>>,
         F: Formulation,
         U: DomainUpdater<D, B::Domain>,
+        K: LockingTreatment<D, M>,
     {
         let materials = &self.problem.materials;
         let model = materials[0].model;
-        let with_law = WithLaw::<D, M, B, F, U, O> {
+        let with_law = WithLaw::<D, M, B, F, U, K, O> {
             run: self,
             basis,
             updater,
+            locking,
             formulation: std::marker::PhantomData,
         };
         if materials.len() == 1 {
@@ -124,19 +155,21 @@ where
     }
 }
 
-struct WithLaw<'a, const D: usize, M, B, F, U, O> {
+struct WithLaw<'a, const D: usize, M, B, F, U, K, O> {
     run: WithVariant<'a, D, M, O>,
     basis: B,
     updater: U,
+    locking: K,
     formulation: std::marker::PhantomData<F>,
 }
 
-impl<const D: usize, M, B, F, U, O> LawVisitor for WithLaw<'_, D, M, B, F, U, O>
+impl<const D: usize, M, B, F, U, K, O> LawVisitor for WithLaw<'_, D, M, B, F, U, K, O>
 where
     M: MovableMesh<D> + Clone,
     B: InitialDomain<D, Mesh = M, Domain: Flat + DomainBounds<D>>,
     F: Formulation,
     U: DomainUpdater<D, B::Domain>,
+    K: LockingTreatment<D, M>,
     O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
     type Output = Result<RunOutput<D>, SolverError>;
@@ -182,11 +215,12 @@ where
             stepping: p.stepping,
             newton: p.newton,
         };
-        simulate_points::<D, B, F, U, L, _, _>(
+        simulate_points::<D, B, F, U, K, L, _, _>(
             points,
             analysis,
             self.basis,
             self.updater,
+            self.locking,
             self.run.control,
             self.run.observer,
         )

@@ -1,0 +1,553 @@
+//! Volumetric-locking studies: Cook's membrane in plane strain on
+//! conforming triangles (standard MPM against F-patch) and on a regular
+//! grid (standard MPM against F-bar).
+//!
+//! The membrane is the quadrilateral (0, 0), (48, 44), (48, 60), (0, 44),
+//! clamped on its left edge, with a total vertical shear `load` spread
+//! uniformly over its right edge; E = 250. The triangles are the linear
+//! children of six-node triangles on the image of a structured square
+//! mesh under the bilinear map of the unit square onto the membrane (its
+//! iso-lines are straight, so the children tile the membrane exactly);
+//! standard MPM runs on the same children and points. The grid holds a
+//! lattice of points, those inside the membrane, so its boundary is a
+//! staircase at the points' spacing.
+//!
+//! The traction is carried by *load points*: points of negligible volume
+//! (1e-9 of their neighbours') at the two Gauss points of every boundary
+//! segment of the right edge, each with its share of the force, so the
+//! nodal forces are the consistent ones of the edge; a probe point at the
+//! corner C = (48, 60) measures the tip displacement.
+
+use mpm_basis::{LinearMpm, LinearSimplex};
+use mpm_constitutive::HenckyElastic;
+use mpm_mesh::{BoxMesh, PatchMesh, QuadraticMesh, RegularGrid};
+use mpm_solver::{
+    FBar, FPatch, ImplicitSolver, LoadStepping, LockingTreatment, MaterialPoints, NewtonOptions,
+    NoLocking, NoUpdate, NodalConstraints, Parts, PreviouslyConverged, SolverError,
+};
+use nalgebra::Vector2;
+
+/// Young's modulus of the membrane.
+pub const YOUNG: f64 = 250.0;
+/// Width of the membrane (x extent).
+pub const WIDTH: f64 = 48.0;
+/// Height of the right edge's lower end.
+const B_Y: f64 = 44.0;
+/// Height of the tip C.
+pub const TIP_Y: f64 = 60.0;
+
+/// Relative volume of a load or probe point.
+const TINY: f64 = 1e-9;
+
+/// The bilinear map of the unit square onto the membrane.
+fn membrane(s: f64, t: f64) -> Vector2<f64> {
+    Vector2::new(WIDTH * s, B_Y * s + t * (B_Y + (TIP_Y - 2.0 * B_Y) * s))
+}
+
+/// Whether `x` lies inside the membrane.
+fn inside(x: &Vector2<f64>) -> bool {
+    let s = x[0] / WIDTH;
+    if !(0.0..=1.0).contains(&s) {
+        return false;
+    }
+    let (lo, hi) = (B_Y * s, B_Y + (TIP_Y - B_Y) * s);
+    x[1] >= lo && x[1] <= hi
+}
+
+/// What a Cook's membrane run is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cook {
+    /// Poisson's ratio.
+    pub nu: f64,
+    /// Total vertical shear on the right edge.
+    pub load: f64,
+    /// Load steps.
+    pub steps: usize,
+    /// Refinement: parent elements per side (triangles) or cells per
+    /// width (grid).
+    pub n: usize,
+}
+
+/// The outcome of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CookResult {
+    /// Vertical displacement of the tip C.
+    pub tip: f64,
+    /// Newton iterations over all steps.
+    pub iterations: usize,
+    /// Free degrees of freedom (last step).
+    pub dofs: usize,
+    /// Wall time of the solver (s).
+    pub seconds: f64,
+}
+
+/// Load points on the right edge between heights `y0 < y1` (two Gauss
+/// points, each with half the segment's share of `load`), nudged into
+/// the body by `inset`.
+fn edge_loads(y0: f64, y1: f64, load: f64, inset: f64) -> [(Vector2<f64>, f64); 2] {
+    let (mid, half) = (0.5 * (y0 + y1), 0.5 * (y1 - y0));
+    let g = half / 3f64.sqrt();
+    let share = load * (y1 - y0) / (TIP_Y - B_Y) / 2.0;
+    [
+        (Vector2::new(WIDTH - inset, mid - g), share),
+        (Vector2::new(WIDTH - inset, mid + g), share),
+    ]
+}
+
+/// Runs `solver` on `points` (the last is the probe) to the full load.
+fn finish<P>(
+    mut solver: ImplicitSolver<2, P>,
+    mut points: MaterialPoints<2, (), ()>,
+    steps: usize,
+) -> Result<CookResult, SolverError>
+where
+    P: mpm_solver::SolverParts<2, History = (), Domain = ()>,
+{
+    let start = std::time::Instant::now();
+    let mut dofs = 0;
+    let summary = solver.run(&mut points, &LoadStepping::uniform(steps), |_, r, _| {
+        dofs = r.free_dofs;
+        Ok(())
+    })?;
+    let probe = points.position.len() - 1;
+    Ok(CookResult {
+        tip: points.displacement[probe][1],
+        iterations: summary.iterations,
+        dofs,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Newton controls of the studies: normalised residual 1e-6. At ν =
+/// 0.4999 (κ/μ = 5000) the residual's round-off floor — the rounding of
+/// the pressure κ ln J against the small deviatoric stresses that carry
+/// the load — reaches 3e-9 to 1e-6 as the mesh is refined, above the
+/// default 1e-9; the study's problems are linear or mildly nonlinear, so
+/// 1e-6 still leaves the tip displacement exact to the digits shown.
+fn newton() -> NewtonOptions {
+    NewtonOptions {
+        weak_node_threshold: 0.0,
+        tolerance: 1e-6,
+        ..NewtonOptions::default()
+    }
+}
+
+/// Cook's membrane on conforming triangles: the children of `n`×`n`×2
+/// six-node triangles, three points per child, with the treatment
+/// `locking` (made from the patch mesh).
+///
+/// # Errors
+/// A [`SolverError`] when the run fails.
+pub fn triangles<K, T>(cook: &Cook, locking: T) -> Result<CookResult, SolverError>
+where
+    K: LockingTreatment<2, mpm_mesh::SimplexMesh<2>>,
+    T: FnOnce(&PatchMesh<2>) -> K,
+{
+    let unit = BoxMesh::new(Vector2::zeros(), Vector2::new(1.0, 1.0), [cook.n, cook.n])
+        .quadratic_mesh()?;
+    let nodes = unit.nodes().iter().map(|x| membrane(x[0], x[1])).collect();
+    let parents = QuadraticMesh::new(nodes, unit.connectivity().to_vec())?;
+    let patches = PatchMesh::from_parents(&parents)?;
+    let mesh = patches.mesh().clone();
+    // Three points per child at the barycentric points (2/3, 1/6, 1/6).
+    let (mut position, mut volume) = (Vec::new(), Vec::new());
+    for e in 0..mesh.element_count() {
+        let v = mesh.element_nodes(e);
+        for k in 0..3 {
+            let x = (0..3).fold(Vector2::zeros(), |acc, a| {
+                acc + mesh.nodes()[v[a]] * if a == k { 2.0 / 3.0 } else { 1.0 / 6.0 }
+            });
+            position.push(x);
+            volume.push(mesh.volumes()[e] / 3.0);
+        }
+    }
+    let small = TINY * volume.iter().copied().fold(f64::INFINITY, f64::min);
+    let inset = 1e-9 * WIDTH;
+    // Right-edge nodes, bottom to top.
+    let mut edge: Vec<f64> = mesh
+        .nodes()
+        .iter()
+        .filter(|x| (x[0] - WIDTH).abs() < 1e-9)
+        .map(|x| x[1])
+        .collect();
+    edge.sort_by(f64::total_cmp);
+    let mut point_force = Vec::new();
+    for w in edge.windows(2) {
+        for (x, f) in edge_loads(w[0], w[1], cook.load, inset) {
+            point_force.push((position.len(), Vector2::new(0.0, f)));
+            position.push(x);
+            volume.push(small);
+        }
+    }
+    position.push(Vector2::new(WIDTH - inset, TIP_Y - inset));
+    volume.push(small);
+    let n = position.len();
+    let mut points = MaterialPoints::new(position, volume, 1.0, vec![(); n])?;
+    points.set_gravity(Vector2::zeros());
+    points.point_force = point_force;
+    let mut c = NodalConstraints::<2>::new(mesh.node_count());
+    for (node, x) in mesh.nodes().iter().enumerate() {
+        if x[0].abs() < 1e-9 {
+            c.fix([node], 0).fix([node], 1);
+        }
+    }
+    let law = HenckyElastic::new(YOUNG, cook.nu)?;
+    let treatment = locking(&patches);
+    let solver: ImplicitSolver<2, Parts<LinearSimplex, PreviouslyConverged, _, K, NoUpdate, _>> =
+        ImplicitSolver::new(LinearSimplex, mesh, law, treatment, NoUpdate, c, newton());
+    finish(solver, points, cook.steps)
+}
+
+/// Cook's membrane on the children of a box of split six-node triangles
+/// that covers the membrane and the room it deforms into ([`background`]),
+/// node spacing 48/`n`, with the grid's lattice of points
+/// ([`grid`]) — the non-conforming background a finite-strain run needs,
+/// since the body leaves a mesh fitted to it.
+///
+/// # Errors
+/// A [`SolverError`] when the run fails.
+pub fn triangles_background<K, T>(cook: &Cook, locking: T) -> Result<CookResult, SolverError>
+where
+    K: LockingTreatment<2, mpm_mesh::SimplexMesh<2>>,
+    T: FnOnce(&PatchMesh<2>) -> K,
+{
+    let h = WIDTH / cook.n as f64;
+    let (lower, cells) = background(h);
+    // Parents of twice the spacing: the children have spacing h.
+    let parents = BoxMesh::new(
+        lower,
+        lower + Vector2::new(cells[0] as f64 * h, cells[1] as f64 * h),
+        [cells[0] / 2, cells[1] / 2],
+    )
+    .quadratic_mesh()?;
+    let patches = PatchMesh::from_parents(&parents)?;
+    let mesh = patches.mesh().clone();
+    let (points, _) = lattice_points(cook, h)?;
+    let c = clamp(mesh.nodes().iter().copied(), mesh.node_count(), h);
+    let law = HenckyElastic::new(YOUNG, cook.nu)?;
+    let treatment = locking(&patches);
+    let solver: ImplicitSolver<2, Parts<LinearSimplex, PreviouslyConverged, _, K, NoUpdate, _>> =
+        ImplicitSolver::new(LinearSimplex, mesh, law, treatment, NoUpdate, c, newton());
+    finish(solver, points, cook.steps)
+}
+
+/// The lower corner and cells (even counts) of a background of spacing
+/// `h` covering the membrane with room to deform: 2 cells below and left,
+/// up to 1.5 × its height and 2 cells beyond its width.
+fn background(h: f64) -> (Vector2<f64>, [usize; 2]) {
+    let even = |x: f64| {
+        let c = (x / h).ceil() as usize;
+        c + c % 2
+    };
+    (
+        Vector2::new(-2.0 * h, -2.0 * h),
+        [even(WIDTH + 4.0 * h), even(1.5 * TIP_Y + 2.0 * h)],
+    )
+}
+
+/// Left-edge nodes clamped.
+fn clamp(nodes: impl Iterator<Item = Vector2<f64>>, count: usize, h: f64) -> NodalConstraints<2> {
+    let mut c = NodalConstraints::<2>::new(count);
+    for (node, x) in nodes.enumerate() {
+        if x[0].abs() < 1e-9 * h {
+            c.fix([node], 0).fix([node], 1);
+        }
+    }
+    c
+}
+
+/// The membrane's lattice points (2 × 2 per cell of spacing `h`, those
+/// inside), its load points and the probe (last).
+fn lattice_points(cook: &Cook, h: f64) -> Result<(MaterialPoints<2, (), ()>, usize), SolverError> {
+    let rows = (TIP_Y / h).ceil() as usize;
+    let per = 2usize;
+    let step = h / per as f64;
+    let (mut position, mut volume) = (Vec::new(), Vec::new());
+    for j in 0..rows * per {
+        for i in 0..cook.n * per {
+            let x = Vector2::new((i as f64 + 0.5) * step, (j as f64 + 0.5) * step);
+            if inside(&x) {
+                position.push(x);
+                volume.push(step * step);
+            }
+        }
+    }
+    let small = TINY * step * step;
+    let inset = 1e-9 * WIDTH;
+    // The right edge in segments of the points' spacing.
+    let segments = ((TIP_Y - B_Y) / step).round().max(1.0) as usize;
+    let mut point_force = Vec::new();
+    for k in 0..segments {
+        let y0 = B_Y + (TIP_Y - B_Y) * k as f64 / segments as f64;
+        let y1 = B_Y + (TIP_Y - B_Y) * (k + 1) as f64 / segments as f64;
+        for (x, f) in edge_loads(y0, y1, cook.load, inset) {
+            point_force.push((position.len(), Vector2::new(0.0, f)));
+            position.push(x);
+            volume.push(small);
+        }
+    }
+    position.push(Vector2::new(WIDTH - inset, TIP_Y - inset));
+    volume.push(small);
+    let n = position.len();
+    let mut points = MaterialPoints::new(position, volume, 1.0, vec![(); n])?;
+    points.set_gravity(Vector2::zeros());
+    points.point_force = point_force;
+    Ok((points, n))
+}
+
+/// Cook's membrane on a regular grid of spacing 48/`n` covering the
+/// membrane and the room it deforms into ([`background`]), 2×2 lattice
+/// points per cell kept inside the membrane, with the treatment
+/// `locking`.
+///
+/// # Errors
+/// A [`SolverError`] when the run fails.
+pub fn grid<K>(cook: &Cook, locking: K) -> Result<CookResult, SolverError>
+where
+    K: LockingTreatment<2, RegularGrid<2>>,
+{
+    let h = WIDTH / cook.n as f64;
+    let (lower, cells) = background(h);
+    let grid = RegularGrid::new(lower, Vector2::new(h, h), cells)?;
+    let (points, _) = lattice_points(cook, h)?;
+    let count = grid.node_count();
+    let nodes = (0..count).map(|v| grid.node_position(v).unwrap_or_else(|_| Vector2::zeros()));
+    let c = clamp(nodes, count, h);
+    let law = HenckyElastic::new(YOUNG, cook.nu)?;
+    let solver: ImplicitSolver<2, Parts<LinearMpm, PreviouslyConverged, _, K, NoUpdate, _>> =
+        ImplicitSolver::new(LinearMpm, grid, law, locking, NoUpdate, c, newton());
+    finish(solver, points, cook.steps)
+}
+
+/// The four runs of one refinement: triangles without and with F-patch
+/// (conforming, or on a background box when `background`), grid without
+/// and with F-bar (in that order), each its result or why it failed.
+pub fn all_four(cook: &Cook, background: bool) -> [Result<CookResult, SolverError>; 4] {
+    let (none, fpatch) = if background {
+        (
+            triangles_background(cook, |_| NoLocking),
+            triangles_background(cook, FPatch::new),
+        )
+    } else {
+        (triangles(cook, |_| NoLocking), triangles(cook, FPatch::new))
+    };
+    [
+        none,
+        fpatch,
+        grid(cook, NoLocking),
+        grid(cook, FBar::default()),
+    ]
+}
+
+/// What a Prandtl footing run is: a smooth rigid strip footing of
+/// half-width 1 pressed into a weightless von Mises layer (half model,
+/// 5 × 5, `n` cells or children across) by a settlement `settlement`
+/// reached in `steps` steps; k = ρ_y/√2 = 1, so the collapse pressure is
+/// 2 + π.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Footing {
+    /// Poisson's ratio.
+    pub nu: f64,
+    /// Young's modulus (the rigidity E/k).
+    pub young: f64,
+    /// Node spacing: the layer's width over `n`.
+    pub n: usize,
+    /// Final settlement of the footing.
+    pub settlement: f64,
+    /// Load steps.
+    pub steps: usize,
+}
+
+/// Width and depth of the half layer.
+pub const LAYER: f64 = 5.0;
+/// Footing half-width.
+pub const HALF_WIDTH: f64 = 1.0;
+
+/// A footing run: settlement and footing pressure after every converged
+/// step, and the failure that stopped it early, if any.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FootingCurve {
+    /// (settlement, pressure / k) per converged step.
+    pub points: Vec<(f64, f64)>,
+    /// Why the run stopped before the full settlement.
+    pub failure: Option<String>,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// Wall time (s).
+    pub seconds: f64,
+}
+
+/// Constraints of the layer: smooth symmetry plane and far side, fixed
+/// base, the footing nodes of the surface (x ≤ half-width) settling.
+fn footing_constraints(
+    nodes: impl Iterator<Item = Vector2<f64>>,
+    count: usize,
+    settlement: f64,
+) -> (NodalConstraints<2>, Vec<usize>) {
+    let tol = 1e-9 * LAYER;
+    let mut c = NodalConstraints::<2>::new(count);
+    let mut footing = Vec::new();
+    for (node, x) in nodes.enumerate() {
+        if x[0].abs() < tol || (x[0] - LAYER).abs() < tol {
+            c.fix([node], 0);
+        }
+        if x[1].abs() < tol {
+            c.fix([node], 0).fix([node], 1);
+        }
+        if (x[1] - LAYER).abs() < tol && x[0] <= HALF_WIDTH + tol {
+            c.prescribe([node], 1, -settlement);
+            footing.push(node);
+        }
+    }
+    (c, footing)
+}
+
+fn footing_run<P>(
+    mut solver: ImplicitSolver<2, P>,
+    mut points: MaterialPoints<2, mpm_constitutive::VonMisesHistory, ()>,
+    footing: &[usize],
+    f: &Footing,
+) -> FootingCurve
+where
+    P: mpm_solver::SolverParts<2, History = mpm_constitutive::VonMisesHistory, Domain = ()>,
+{
+    let start = std::time::Instant::now();
+    let mut curve = FootingCurve::default();
+    let result = solver.run(&mut points, &LoadStepping::uniform(f.steps), |_, r, _| {
+        let force: f64 = r
+            .node_reactions
+            .iter()
+            .filter(|(node, _)| footing.binary_search(node).is_ok())
+            .map(|(_, v)| v[1])
+            .sum();
+        curve
+            .points
+            .push((r.lambda1 * f.settlement, -force / HALF_WIDTH));
+        curve.iterations += r.residuals.len();
+        Ok(())
+    });
+    if let Err(e) = result {
+        curve.failure = Some(e.to_string());
+    }
+    curve.seconds = start.elapsed().as_secs_f64();
+    curve
+}
+
+fn footing_law(f: &Footing) -> Result<mpm_constitutive::VonMises, SolverError> {
+    Ok(mpm_constitutive::VonMises::new(
+        f.young,
+        f.nu,
+        2f64.sqrt(),
+        0.0,
+    )?)
+}
+
+/// The footing on a regular grid with 2 × 2 points per cell.
+///
+/// # Errors
+/// A [`SolverError`] when the problem cannot be set up (a failing run is
+/// reported in the curve).
+pub fn footing_grid<K>(f: &Footing, locking: K) -> Result<FootingCurve, SolverError>
+where
+    K: LockingTreatment<2, RegularGrid<2>>,
+{
+    let h = LAYER / f.n as f64;
+    let grid = RegularGrid::new(Vector2::new(-h, -h), Vector2::new(h, h), [f.n + 2, f.n + 2])?;
+    let step = h / 2.0;
+    let mut position = Vec::new();
+    for j in 0..2 * f.n {
+        for i in 0..2 * f.n {
+            position.push(Vector2::new(
+                (i as f64 + 0.5) * step,
+                (j as f64 + 0.5) * step,
+            ));
+        }
+    }
+    let n = position.len();
+    let mut points = MaterialPoints::new(position, vec![step * step; n], 1.0, vec![(); n])?;
+    points.set_gravity(Vector2::zeros());
+    let count = grid.node_count();
+    let nodes = (0..count).map(|v| grid.node_position(v).unwrap_or_else(|_| Vector2::zeros()));
+    let (c, footing) = footing_constraints(nodes, count, f.settlement);
+    let solver: ImplicitSolver<2, Parts<LinearMpm, PreviouslyConverged, _, K, NoUpdate, _>> =
+        ImplicitSolver::new(
+            LinearMpm,
+            grid,
+            footing_law(f)?,
+            locking,
+            NoUpdate,
+            c,
+            newton(),
+        );
+    Ok(footing_run(solver, points, &footing, f))
+}
+
+/// The footing on the children of (`n`/2)² × 2 six-node triangles (node
+/// spacing as the grid's; two more parent rows above the surface), 3
+/// points per child below the surface.
+///
+/// # Errors
+/// As [`footing_grid`].
+pub fn footing_triangles<K, T>(f: &Footing, locking: T) -> Result<FootingCurve, SolverError>
+where
+    K: LockingTreatment<2, mpm_mesh::SimplexMesh<2>>,
+    T: FnOnce(&PatchMesh<2>) -> K,
+{
+    // Two parent rows above the surface leave room for the heave.
+    let h = 2.0 * LAYER / f.n as f64;
+    let parents = BoxMesh::new(
+        Vector2::zeros(),
+        Vector2::new(LAYER, LAYER + 2.0 * h),
+        [f.n / 2, f.n / 2 + 2],
+    )
+    .quadratic_mesh()?;
+    let patches = PatchMesh::from_parents(&parents)?;
+    let mesh = patches.mesh().clone();
+    let (mut position, mut volume) = (Vec::new(), Vec::new());
+    for e in 0..mesh.element_count() {
+        let v = mesh.element_nodes(e);
+        for k in 0..3 {
+            let x = (0..3).fold(Vector2::zeros(), |acc, a| {
+                acc + mesh.nodes()[v[a]] * if a == k { 2.0 / 3.0 } else { 1.0 / 6.0 }
+            });
+            if x[1] < LAYER {
+                position.push(x);
+                volume.push(mesh.volumes()[e] / 3.0);
+            }
+        }
+    }
+    let n = position.len();
+    let mut points = MaterialPoints::new(position, volume, 1.0, vec![(); n])?;
+    points.set_gravity(Vector2::zeros());
+    let (c, footing) = footing_constraints(
+        mesh.nodes().iter().copied(),
+        mesh.node_count(),
+        f.settlement,
+    );
+    let treatment = locking(&patches);
+    let solver: ImplicitSolver<2, Parts<LinearSimplex, PreviouslyConverged, _, K, NoUpdate, _>> =
+        ImplicitSolver::new(
+            LinearSimplex,
+            mesh,
+            footing_law(f)?,
+            treatment,
+            NoUpdate,
+            c,
+            newton(),
+        );
+    Ok(footing_run(solver, points, &footing, f))
+}
+
+/// The four footing runs of one refinement, in the order of
+/// [`all_four`].
+///
+/// # Errors
+/// As [`footing_grid`].
+pub fn footing_all_four(f: &Footing) -> Result<[FootingCurve; 4], SolverError> {
+    Ok([
+        footing_triangles(f, |_| NoLocking)?,
+        footing_triangles(f, FPatch::new)?,
+        footing_grid(f, NoLocking)?,
+        footing_grid(f, FBar::default())?,
+    ])
+}
