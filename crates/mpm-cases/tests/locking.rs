@@ -1,6 +1,6 @@
 //! Locking in Cook's membrane (plane strain, `mpm_cases::locking`): at
 //! ν = 0.4999 standard MPM locks on triangles and on the grid, F-patch and
-//! F-bar do not; at ν = 0.3 the treatments change little. The full study
+//! F-bar do not; at ν = 0.3 the treatments change the tip by under 10 %. The full study
 //! is `cargo xtask reproduce locking` (docs/src/reproduction/locking.md).
 #![allow(clippy::unwrap_used)]
 
@@ -31,8 +31,9 @@ fn standard_mpm_locks_and_the_treatments_do_not() {
     println!(
         "ν = 0.3, n = 8: triangles {tri3:.4} / F-patch {fpatch3:.4}, grid {grid3:.4} / F-bar {fbar3:.4}"
     );
-    // Compressible: every variant within 10 % of F-bar.
-    for t in [tri3, fpatch3, grid3] {
-        assert!((t - fbar3).abs() < 0.1 * fbar3, "{t} {fbar3}");
-    }
+    // Compressible: on each mesh the treatment changes the tip by less
+    // than 10 % (measured 7 % on triangles, whose standard run is also
+    // stiffer in bending, and 3 % on the grid).
+    assert!((tri3 - fpatch3).abs() < 0.1 * fpatch3, "{tri3} {fpatch3}");
+    assert!((grid3 - fbar3).abs() < 0.1 * fbar3, "{grid3} {fbar3}");
 }
