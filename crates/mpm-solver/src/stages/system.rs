@@ -156,53 +156,40 @@ impl<const D: usize> StepSystem<D> {
 
     /// Sorted neighbour lists: nodes sharing at least one point.
     pub fn build_neighbours(&mut self) {
-        let n = self.n_active();
-        let mut mark = vec![NONE; n];
-        let mut row: Vec<u32> = Vec::with_capacity(64);
-        self.nb_ptr.clear();
-        self.nb_ptr.push(0);
-        self.nb.clear();
-        for w in 0..n {
-            row.clear();
-            for &(p, _) in &self.adj[self.adj_ptr[w]..self.adj_ptr[w + 1]] {
-                for s in self.slots(p as usize) {
-                    let v = self.nodes[s];
-                    if mark[v as usize] != w as u32 {
-                        mark[v as usize] = w as u32;
-                        row.push(v);
-                    }
+        let (adj_ptr, adj) = (
+            std::mem::take(&mut self.adj_ptr),
+            std::mem::take(&mut self.adj),
+        );
+        let (stride, counts, nodes) = (self.stride, &self.counts, &self.nodes);
+        let mut nb_ptr = std::mem::take(&mut self.nb_ptr);
+        let mut nb = std::mem::take(&mut self.nb);
+        neighbour_lists(self.active.len(), &mut nb_ptr, &mut nb, |w, push| {
+            for &(p, _) in &adj[adj_ptr[w]..adj_ptr[w + 1]] {
+                let start = p as usize * stride;
+                for &v in &nodes[start..start + counts[p as usize] as usize] {
+                    push(v);
                 }
             }
-            row.sort_unstable();
-            self.nb.extend_from_slice(&row);
-            self.nb_ptr.push(self.nb.len());
-        }
+        });
+        (self.adj_ptr, self.adj, self.nb_ptr, self.nb) = (adj_ptr, adj, nb_ptr, nb);
     }
 
     /// Sorted neighbour lists of a patch-coupled step: nodes sharing a
     /// patch (a superset of the nodes sharing a point, since a patch's
     /// union holds its points' stencils).
     pub fn build_patch_neighbours(&mut self, patches: &PatchSystem<D>) {
-        let n = self.n_active();
-        let mut mark = vec![NONE; n];
-        let mut row: Vec<u32> = Vec::with_capacity(64);
-        self.nb_ptr.clear();
-        self.nb_ptr.push(0);
-        self.nb.clear();
-        for w in 0..n {
-            row.clear();
-            for &(k, _) in &patches.node_patches[patches.node_ptr[w]..patches.node_ptr[w + 1]] {
-                for &v in patches.union_of(k as usize) {
-                    if mark[v as usize] != w as u32 {
-                        mark[v as usize] = w as u32;
-                        row.push(v);
+        neighbour_lists(
+            self.active.len(),
+            &mut self.nb_ptr,
+            &mut self.nb,
+            |w, push| {
+                for &(k, _) in &patches.node_patches[patches.node_ptr[w]..patches.node_ptr[w + 1]] {
+                    for &v in patches.union_of(k as usize) {
+                        push(v);
                     }
                 }
-            }
-            row.sort_unstable();
-            self.nb.extend_from_slice(&row);
-            self.nb_ptr.push(self.nb.len());
-        }
+            },
+        );
     }
 
     /// Whether every dof of active node `v` is free (after
@@ -304,5 +291,33 @@ impl<const D: usize> StepSystem<D> {
             }
         }
         self.block_ptr.push(self.row_idx.len());
+    }
+}
+
+/// Sorted, duplicate-free neighbour lists of `n` nodes into the CSR
+/// `nb_ptr`/`nb`: node `w`'s list holds every node `candidates(w, push)`
+/// pushes.
+fn neighbour_lists(
+    n: usize,
+    nb_ptr: &mut Vec<usize>,
+    nb: &mut Vec<u32>,
+    candidates: impl Fn(usize, &mut dyn FnMut(u32)),
+) {
+    let mut mark = vec![NONE; n];
+    let mut row: Vec<u32> = Vec::with_capacity(64);
+    nb_ptr.clear();
+    nb_ptr.push(0);
+    nb.clear();
+    for w in 0..n {
+        row.clear();
+        candidates(w, &mut |v| {
+            if mark[v as usize] != w as u32 {
+                mark[v as usize] = w as u32;
+                row.push(v);
+            }
+        });
+        row.sort_unstable();
+        nb.extend_from_slice(&row);
+        nb_ptr.push(nb.len());
     }
 }
