@@ -7,6 +7,8 @@
 //! formulations give the same solution.
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use mpm_basis::{BasisFunction, Gimp, LinearMpm, LinearSimplex};
 use mpm_constitutive::{HenckyElastic, LogStrainLaw, VonMises};
 use mpm_mesh::{BoxMesh, PatchMesh, RegularGrid, SimplexMesh, SplitMix64};
@@ -73,24 +75,7 @@ where
     let n = solver.prepare_step(points, 0.0, 1.0).unwrap();
     let du: Vec<f64> = (0..n).map(|_| amplitude * rng.symmetric()).collect();
     let k = solver.free_stiffness_dense(points, &du).unwrap();
-    let step = 1e-6;
-    let mut worst = 0.0f64;
-    for c in 0..n {
-        let mut plus = du.clone();
-        plus[c] += step;
-        let mut minus = du.clone();
-        minus[c] -= step;
-        let rp = solver.free_residual(points, &plus).unwrap();
-        let rm = solver.free_residual(points, &minus).unwrap();
-        let col = &k[c * n..(c + 1) * n];
-        let (mut err, mut norm) = (0.0f64, 0.0f64);
-        for r in 0..n {
-            let fd = (rp[r] - rm[r]) / (2.0 * step);
-            err += (col[r] - fd).powi(2);
-            norm += fd * fd;
-        }
-        worst = worst.max(err.sqrt() / norm.sqrt().max(1e-300));
-    }
+    let worst = common::worst_column_error(solver, points, &du, &k);
     println!("{} {} n = {n}: {worst:e}", K::NAME, F::NAME);
     worst
 }

@@ -3,6 +3,8 @@
 //! mpm-basis, both formulations, elastic and plastic laws, in 2D and 3D.
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use mpm_basis::{BasisFunction, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_constitutive::{HenckyElastic, LogStrainLaw, VonMises};
 use mpm_mesh::RegularGrid;
@@ -73,31 +75,7 @@ where
         exported[c * n + r] += *v;
     }
     assert_eq!(exported, k);
-    let step = 1e-6;
-    let mut worst = 0.0f64;
-    for c in 0..n {
-        let mut plus = du.clone();
-        plus[c] += step;
-        let mut minus = du.clone();
-        minus[c] -= step;
-        let rp = solver.free_residual(&points, &plus).unwrap();
-        let rm = solver.free_residual(&points, &minus).unwrap();
-        let fd: Vec<f64> = rp
-            .iter()
-            .zip(&rm)
-            .map(|(a, b)| (a - b) / (2.0 * step))
-            .collect();
-        let col = &k[c * n..(c + 1) * n];
-        let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let err = col
-            .iter()
-            .zip(&fd)
-            .map(|(a, b)| (a - b) * (a - b))
-            .sum::<f64>()
-            .sqrt();
-        worst = worst.max(err / norm.max(1e-300));
-    }
-    worst
+    common::worst_column_error(&mut solver, &points, &du, &k)
 }
 
 macro_rules! stiffness_tests {
