@@ -341,7 +341,8 @@ pub fn all_four(cook: &Cook, background: bool) -> [Result<CookResult, SolverErro
 
 /// What a Prandtl footing run is: a smooth rigid strip footing of
 /// half-width 1 pressed into a weightless von Mises layer (half model,
-/// 5 × 5, `n` cells or children across) by a settlement `settlement`
+/// 5 × 5, `n` cells or children across, `n` a multiple of 10 so that
+/// the footing edge is a node) by a settlement `settlement`
 /// reached in `steps` steps; k = ρ_y/√2 = 1, so the collapse pressure is
 /// 2 + π.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -373,6 +374,8 @@ pub struct FootingCurve {
     pub failure: Option<String>,
     /// Newton iterations.
     pub iterations: usize,
+    /// Normalised residuals of every Newton iteration, per converged step.
+    pub residuals: Vec<Vec<f64>>,
     /// Wall time (s).
     pub seconds: f64,
 }
@@ -424,6 +427,7 @@ where
             .points
             .push((r.lambda1 * f.settlement, -force / HALF_WIDTH));
         curve.iterations += r.residuals.len();
+        curve.residuals.push(r.residuals.clone());
         Ok(())
     });
     if let Err(e) = result {
@@ -451,7 +455,7 @@ pub fn footing_grid<K>(f: &Footing, locking: K) -> Result<FootingCurve, SolverEr
 where
     K: LockingTreatment<2, RegularGrid<2>>,
 {
-    let h = LAYER / f.n as f64;
+    let h = footing_spacing(f)?;
     let grid = RegularGrid::new(Vector2::new(-h, -h), Vector2::new(h, h), [f.n + 2, f.n + 2])?;
     let step = h / 2.0;
     let mut position = Vec::new();
@@ -494,7 +498,7 @@ where
     T: FnOnce(&PatchMesh<2>) -> K,
 {
     // Two parent rows above the surface leave room for the heave.
-    let h = 2.0 * LAYER / f.n as f64;
+    let h = 2.0 * footing_spacing(f)?;
     let parents = BoxMesh::new(
         Vector2::zeros(),
         Vector2::new(LAYER, LAYER + 2.0 * h),
@@ -539,15 +543,36 @@ where
 }
 
 /// The four footing runs of one refinement, in the order of
-/// [`all_four`].
+/// [`all_four`]; F-patch only when `fpatch` (it is the slow one).
 ///
 /// # Errors
 /// As [`footing_grid`].
-pub fn footing_all_four(f: &Footing) -> Result<[FootingCurve; 4], SolverError> {
+pub fn footing_all_four(
+    f: &Footing,
+    fpatch: bool,
+) -> Result<[Option<FootingCurve>; 4], SolverError> {
     Ok([
-        footing_triangles(f, |_| NoLocking)?,
-        footing_triangles(f, FPatch::new)?,
-        footing_grid(f, NoLocking)?,
-        footing_grid(f, FBar::default())?,
+        Some(footing_triangles(f, |_| NoLocking)?),
+        if fpatch {
+            Some(footing_triangles(f, FPatch::new)?)
+        } else {
+            None
+        },
+        Some(footing_grid(f, NoLocking)?),
+        Some(footing_grid(f, FBar::default())?),
     ])
+}
+
+/// The node spacing of `f`, refused unless the footing edge falls on a
+/// node (`n` a multiple of 10: the triangles' parents are two spacings
+/// wide) — with the edge between nodes the footing's width is not the
+/// one the pressure is divided by.
+fn footing_spacing(f: &Footing) -> Result<f64, SolverError> {
+    if f.n == 0 || f.n % 10 != 0 {
+        return Err(SolverError::InvalidInput(format!(
+            "footing: n = {} must be a positive multiple of 10 so that the footing edge x = {HALF_WIDTH} is a node of the grid and of the triangles",
+            f.n
+        )));
+    }
+    Ok(LAYER / f.n as f64)
 }

@@ -154,3 +154,39 @@ fn bad_grid_size_is_a_clear_error() {
     let err = run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap_err();
     assert!(err.to_string().contains("needs basis = gimp"), "{err}");
 }
+
+/// The column's scene with `locking = "fbar"` (cell patches): it runs
+/// through the scene dispatch, UL and PC agree, and the error against
+/// eqs. 41-42 stays that of standard MPM's order (one-dimensional
+/// compaction at ν = 0 has no volumetric constraint to relieve).
+#[test]
+fn the_column_scene_runs_with_fbar() {
+    use mpm_cases::variant::{LockingKind, Variant};
+    let mut errors = Vec::new();
+    let mut last = Vec::new();
+    for (formulation, locking) in [
+        (FormulationKind::Pc, LockingKind::None),
+        (FormulationKind::Pc, LockingKind::FBar),
+        (FormulationKind::Ul, LockingKind::FBar),
+    ] {
+        let p = params(3, BasisKind::Linear, formulation, DomainUpdateKind::None);
+        let v = Variant {
+            locking,
+            ..p.variant()
+        };
+        let r = run(&p, &v, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+        println!("{formulation} {locking}: error {:.4e}", r.error);
+        errors.push(r.error);
+        last.push(r.output.last.position.clone());
+    }
+    let dx = last[1]
+        .iter()
+        .zip(&last[2])
+        .map(|(a, b)| (a[1] - b[1]).abs())
+        .fold(0.0, f64::max);
+    assert!(dx <= 1e-8 * 50.0, "{dx:e}");
+    assert!(
+        errors[1].is_finite() && errors[1] < 2.0 * errors[0] + 1e-12,
+        "{errors:?}"
+    );
+}

@@ -157,10 +157,13 @@ pub struct StretchResult {
 /// with the face y1 driven (also laterally with `clamped_top`).
 ///
 /// # Errors
-/// [`SolverError::InvalidInput`] for a variant other than standard MPM.
+/// [`SolverError::InvalidInput`] for a variant other than standard MPM or
+/// F-patch.
 pub fn scene_text(p: &StretchParams, variant: &Variant) -> Result<String, SolverError> {
+    // The built-in mesh splits ten-node parents (patches); a Gmsh mesh has
+    // patches when it is quadratic, which the scene checks.
     variant
-        .require_standard_mpm("tetrahedra")
+        .require_simplex("tetrahedra", true)
         .map_err(SolverError::InvalidInput)?;
     let mesh = match &p.mesh {
         Some(path) => format!(
@@ -211,7 +214,7 @@ pub fn problem(p: &StretchParams, variant: &Variant) -> Result<Problem<3>, Solve
     super::build_scene(&scene_text(p, variant)?, "stretch", 0)
 }
 
-/// Runs the stretch with `variant` (standard MPM on tetrahedra; UL or PC):
+/// Runs the stretch with `variant` (standard MPM or F-patch; UL or PC):
 /// its scene ([`scene_text`]), built and run, measured against the
 /// uniaxial stress.
 ///
