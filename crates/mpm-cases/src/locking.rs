@@ -568,7 +568,7 @@ pub fn footing_all_four(
 /// wide) — with the edge between nodes the footing's width is not the
 /// one the pressure is divided by.
 fn footing_spacing(f: &Footing) -> Result<f64, SolverError> {
-    if f.n == 0 || f.n % 10 != 0 {
+    if f.n == 0 || !f.n.is_multiple_of(10) {
         return Err(SolverError::InvalidInput(format!(
             "footing: n = {} must be a positive multiple of 10 so that the footing edge x = {HALF_WIDTH} is a node of the grid and of the triangles",
             f.n
