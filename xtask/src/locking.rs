@@ -190,6 +190,9 @@ const FOOTING_REFINEMENTS: [usize; 4] = [10, 20, 40, 80];
 /// is about 8 minutes, so its finest run is n = 40.
 const FPATCH_FINEST: usize = 40;
 
+/// (settlement, pressure / k) of one footing run.
+type Curve = Vec<(f64, f64)>;
+
 /// The Prandtl footing: pressure against settlement per treatment.
 fn footing(md: &mut String, img: &Path) -> Result<()> {
     let collapse = 2.0 + std::f64::consts::PI;
@@ -226,7 +229,7 @@ fn footing(md: &mut String, img: &Path) -> Result<()> {
             .chain(["Newton iterations (4 runs)".to_string()]),
     );
     let mut series = Vec::new();
-    let mut finest: [Option<(usize, Vec<(f64, f64)>)>; 4] = Default::default();
+    let mut finest: [Option<(usize, Curve)>; 4] = Default::default();
     for n in FOOTING_REFINEMENTS {
         let f = Footing { n, ..base };
         let curves = footing_all_four(&f, n <= FPATCH_FINEST)?;
