@@ -156,22 +156,21 @@ impl<const D: usize> StepSystem<D> {
 
     /// Sorted neighbour lists: nodes sharing at least one point.
     pub fn build_neighbours(&mut self) {
-        let (adj_ptr, adj) = (
-            std::mem::take(&mut self.adj_ptr),
-            std::mem::take(&mut self.adj),
-        );
+        let (adj_ptr, adj) = (&self.adj_ptr, &self.adj);
         let (stride, counts, nodes) = (self.stride, &self.counts, &self.nodes);
-        let mut nb_ptr = std::mem::take(&mut self.nb_ptr);
-        let mut nb = std::mem::take(&mut self.nb);
-        neighbour_lists(self.active.len(), &mut nb_ptr, &mut nb, |w, push| {
-            for &(p, _) in &adj[adj_ptr[w]..adj_ptr[w + 1]] {
-                let start = p as usize * stride;
-                for &v in &nodes[start..start + counts[p as usize] as usize] {
-                    push(v);
+        neighbour_lists(
+            self.active.len(),
+            &mut self.nb_ptr,
+            &mut self.nb,
+            |w, push| {
+                for &(p, _) in &adj[adj_ptr[w]..adj_ptr[w + 1]] {
+                    let start = p as usize * stride;
+                    for &v in &nodes[start..start + counts[p as usize] as usize] {
+                        push(v);
+                    }
                 }
-            }
-        });
-        (self.adj_ptr, self.adj, self.nb_ptr, self.nb) = (adj_ptr, adj, nb_ptr, nb);
+            },
+        );
     }
 
     /// Sorted neighbour lists of a patch-coupled step: nodes sharing a
