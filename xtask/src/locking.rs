@@ -44,7 +44,13 @@ pub fn run(docs: &Path) -> Result<()> {
          Grid: n cells across the 48 wide membrane, 2 × 2 lattice points per cell kept inside it \
          (a staircase boundary), standard MPM and F-bar (one cell per patch). The tip is the \
          vertical displacement of the corner (48, 60). The small load is {SMALL} of the full one; \
-         its tip displacement is scaled back to a load of 100 (linear response).\n",
+         its tip displacement is scaled back to a load of 100 (linear response). Small load: \
+         points of negligible volume at the Gauss points of the right edge carry the traction \
+         (consistent nodal forces) and a probe point at the corner measures the tip. Full load: \
+         such points drift into cells no real point covers, whose nodes have next to no \
+         stiffness, so the real points of the column nearest the right edge carry the traction \
+         (each the share of the edge nearest it) and the tip is the least-squares linear \
+         extrapolation to the corner of the six points nearest it.\n",
         machine::today(),
         machine::description()
     )?;

@@ -304,13 +304,11 @@ type Outcome = (Vec<Vec<f64>>, Vec<SVector<f64, 2>>, Vec<Matrix3<f64>>);
 
 /// The von Mises stress at yield of the block.
 const YIELD: f64 = 20.0;
-/// Load steps of the block.
-const STEPS: usize = 10;
 
 /// A von Mises block on a grid pressed by a prescribed top displacement
 /// until it yields throughout, with F-bar: the Newton residuals, per step,
-/// of both formulations and the final positions.
-fn yielding_block<F: Formulation, K>(locking: K) -> Outcome
+/// of both formulations and the final positions, over `steps` load steps.
+fn yielding_block<F: Formulation, K>(locking: K, steps: usize) -> Outcome
 where
     K: LockingTreatment<2, RegularGrid<2>>,
 {
@@ -359,7 +357,7 @@ where
     solver
         .run(
             &mut points,
-            &LoadStepping::uniform(STEPS),
+            &LoadStepping::uniform(steps),
             |_, report, _| {
                 residuals.push(report.residuals.clone());
                 Ok(())
@@ -392,54 +390,65 @@ fn rates(residuals: &[Vec<f64>]) -> (Vec<f64>, Vec<f64>) {
     (ratio, order)
 }
 
+/// Quadratic convergence past yield with the coupled F-bar tangent, both
+/// formulations. With r_k+1 = C r_k² the log ratio is 2 + ln C / ln r_k:
+/// C is the normalised residual's constant, proportional to the load
+/// step (the residual is normalised by the step's first one), so over 10
+/// steps (C = 20-80) the log ratio sits at 1.71-1.88 while the
+/// C-independent order estimate is 2; over 80 steps C is eight times
+/// smaller and the log ratio itself passes 1.8 in every step (measured
+/// 1.88-1.91).
 #[test]
 fn coupled_tangent_converges_quadratically_past_yield() {
-    for (name, (residuals, _, sigma)) in [
-        (
-            "ul",
-            yielding_block::<UpdatedLagrangian, _>(FBar::default()),
-        ),
-        (
-            "pc",
-            yielding_block::<PreviouslyConverged, _>(FBar::default()),
-        ),
-    ] {
-        // Past yield: the von Mises stress reaches ρ_y at most points.
-        let yielded = sigma
-            .iter()
-            .filter(|s| {
-                let dev = *s - Matrix3::identity() * (s.trace() / 3.0);
-                (1.5f64).sqrt() * dev.norm() > 0.99 * YIELD
-            })
-            .count();
-        let (ratio, order) = rates(&residuals);
-        let median = |v: &[f64]| v[v.len() / 2];
-        println!(
-            "{name}: {} steps, {yielded}/{} points at yield; log ratio median {:.2} (min {:.2}), order median {:.2} (min {:.2})",
-            residuals.len(),
-            sigma.len(),
-            median(&ratio),
-            ratio[0],
-            median(&order),
-            order[0]
-        );
-        for r in residuals.iter().take(3) {
-            println!("  {r:?}");
+    for steps in [10, 80] {
+        for (name, (residuals, _, sigma)) in [
+            (
+                "ul",
+                yielding_block::<UpdatedLagrangian, _>(FBar::default(), steps),
+            ),
+            (
+                "pc",
+                yielding_block::<PreviouslyConverged, _>(FBar::default(), steps),
+            ),
+        ] {
+            // Past yield: the von Mises stress reaches ρ_y at most points.
+            let yielded = sigma
+                .iter()
+                .filter(|s| {
+                    let dev = *s - Matrix3::identity() * (s.trace() / 3.0);
+                    (1.5f64).sqrt() * dev.norm() > 0.99 * YIELD
+                })
+                .count();
+            let (ratio, order) = rates(&residuals);
+            let median = |v: &[f64]| v[v.len() / 2];
+            println!(
+                "{name}, {steps} steps: {yielded}/{} points at yield; log ratio median {:.2} (min {:.2}) over {} steps, order median {:.2} (min {:.2})",
+                sigma.len(),
+                median(&ratio),
+                ratio[0],
+                ratio.len(),
+                median(&order),
+                order.first().copied().unwrap_or(f64::NAN)
+            );
+            for r in residuals.iter().take(3) {
+                println!("  {r:?}");
+            }
+            assert!(yielded * 2 > sigma.len(), "{yielded}");
+            if steps == 10 {
+                assert!(median(&order) >= 1.9, "{order:?}");
+                assert!(order[0] >= 1.5, "{order:?}");
+            } else {
+                assert!(ratio[0] >= 1.8, "{ratio:?}");
+            }
         }
-        assert!(yielded * 2 > sigma.len(), "{yielded}");
-        // The order estimate is the measure of quadratic convergence; the
-        // log ratio (printed) sits at 1.71-1.88 here because C = 20-80 on
-        // this block, and would need residuals below round-off to pass 1.8.
-        assert!(median(&order) >= 1.9, "{order:?}");
-        assert!(order[0] >= 1.5, "{order:?}");
     }
 }
 
 #[test]
 fn updated_lagrangian_and_previously_converged_agree_with_fbar() {
-    let (_, xu, su) = yielding_block::<UpdatedLagrangian, _>(FBar::default());
-    let (_, xp, sp) = yielding_block::<PreviouslyConverged, _>(FBar::default());
-    let (_, x0, _) = yielding_block::<UpdatedLagrangian, _>(mpm_solver::NoLocking);
+    let (_, xu, su) = yielding_block::<UpdatedLagrangian, _>(FBar::default(), 10);
+    let (_, xp, sp) = yielding_block::<PreviouslyConverged, _>(FBar::default(), 10);
+    let (_, x0, _) = yielding_block::<UpdatedLagrangian, _>(mpm_solver::NoLocking, 10);
     let treated = xu
         .iter()
         .zip(&x0)
