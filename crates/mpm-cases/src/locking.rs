@@ -185,11 +185,6 @@ fn newton(weak_node_threshold: f64) -> NewtonOptions {
     }
 }
 
-/// Default weak-node threshold of [`NewtonOptions`].
-fn default_weak() -> f64 {
-    NewtonOptions::default().weak_node_threshold
-}
-
 /// How a lattice run carries the traction and measures the tip.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Traction {
@@ -201,6 +196,25 @@ pub enum Traction {
     /// [`extrapolated_tip`]: robust when the body moves into empty cells
     /// (finite strain), at a first-order error in the load's position.
     BoundaryColumn,
+}
+
+impl Traction {
+    /// The weak-node threshold of the run: 0 where load or probe points
+    /// of negligible volume must keep the nodes they touch free.
+    fn weak_node_threshold(self) -> f64 {
+        match self {
+            Traction::EdgeGaussPoints => 0.0,
+            Traction::BoundaryColumn => NewtonOptions::default().weak_node_threshold,
+        }
+    }
+
+    /// The tip displacement in y of the final points.
+    fn tip(self, points: &MaterialPoints<2, (), ()>) -> f64 {
+        match self {
+            Traction::EdgeGaussPoints => probe(points),
+            Traction::BoundaryColumn => extrapolated_tip(points),
+        }
+    }
 }
 
 /// Cook's membrane on conforming triangles: the children of `n`×`n`×2
@@ -272,7 +286,7 @@ where
             treatment,
             NoUpdate,
             c,
-            newton(0.0),
+            newton(Traction::EdgeGaussPoints.weak_node_threshold()),
         );
     finish(solver, points, cook.steps, probe)
 }
@@ -305,10 +319,12 @@ where
     let c = clamp(mesh.nodes().iter().copied(), mesh.node_count(), h);
     let law = HenckyElastic::new(YOUNG, cook.nu)?;
     let treatment = locking(&patches);
-    let options = newton(default_weak());
+    let options = newton(Traction::BoundaryColumn.weak_node_threshold());
     let solver: ImplicitSolver<2, Parts<LinearSimplex, PreviouslyConverged, _, K, NoUpdate, _>> =
         ImplicitSolver::new(LinearSimplex, mesh, law, treatment, NoUpdate, c, options);
-    finish(solver, points, cook.steps, extrapolated_tip)
+    finish(solver, points, cook.steps, |p| {
+        Traction::BoundaryColumn.tip(p)
+    })
 }
 
 /// The lower corner and cells (even counts) of a background of spacing
@@ -441,17 +457,10 @@ where
     let nodes = (0..count).map(|v| grid.node_position(v).unwrap_or_else(|_| Vector2::zeros()));
     let c = clamp(nodes, count, h);
     let law = HenckyElastic::new(YOUNG, cook.nu)?;
-    let options = newton(match traction {
-        Traction::EdgeGaussPoints => 0.0,
-        Traction::BoundaryColumn => default_weak(),
-    });
+    let options = newton(traction.weak_node_threshold());
     let solver: ImplicitSolver<2, Parts<LinearMpm, PreviouslyConverged, _, K, NoUpdate, _>> =
         ImplicitSolver::new(LinearMpm, grid, law, locking, NoUpdate, c, options);
-    let tip = match traction {
-        Traction::EdgeGaussPoints => probe,
-        Traction::BoundaryColumn => extrapolated_tip,
-    };
-    finish(solver, points, cook.steps, tip)
+    finish(solver, points, cook.steps, |p| traction.tip(p))
 }
 
 /// The four runs of one refinement: triangles without and with F-patch
