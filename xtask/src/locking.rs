@@ -9,6 +9,7 @@ use std::path::Path;
 
 use anyhow::Result;
 use mpm_cases::locking::{Cook, Footing, all_four, footing_all_four};
+use mpm_solver::SolverError;
 
 use crate::markdown::Table;
 use crate::plot::{Axis, Figure, Line, Marker, PALETTE, Series};
@@ -66,6 +67,7 @@ pub fn run(docs: &Path) -> Result<()> {
         let scale = 100.0 / load;
         writeln!(md, "## {title}\n")?;
         let mut series = Vec::new();
+        let mut finest: Vec<(f64, [Option<f64>; 4])> = Vec::new();
         // ν = 1/3 is the published case: a reference for the small load.
         let nus: &[f64] = if steps == 1 {
             &[1.0 / 3.0, 0.3, 0.4999]
@@ -98,7 +100,7 @@ pub fn run(docs: &Path) -> Result<()> {
                             row.push(format!("{:.4}", r.tip * scale));
                             c.push((n as f64, r.tip * scale));
                         }
-                        Err(e) => row.push(format!("failed: {}", short(&e.to_string()))),
+                        Err(e) => row.push(failure(e)),
                     }
                 }
                 row.push(
@@ -109,6 +111,9 @@ pub fn run(docs: &Path) -> Result<()> {
                         .join(" / "),
                 );
                 table.row(row);
+                if n == REFINEMENTS[REFINEMENTS.len() - 1] {
+                    finest.push((nu, results.map(|r| r.ok().map(|r| r.tip))));
+                }
             }
             let label = if nu == 1.0 / 3.0 {
                 "1/3".to_string()
@@ -130,6 +135,9 @@ pub fn run(docs: &Path) -> Result<()> {
                     line: if k == 1 { Line::Solid } else { Line::Dashed },
                 });
             }
+        }
+        if steps > 1 {
+            writeln!(md, "{}", full_load_reading(&finest))?;
         }
         let file = if steps == 1 {
             "locking-cook-small.png"
@@ -184,9 +192,62 @@ fn published_reference() -> String {
     )
 }
 
+/// A failed run in a table cell: the step and the cause for a step that
+/// could not be completed, otherwise the error's first 80 characters.
+fn failure(e: &SolverError) -> String {
+    match e {
+        SolverError::StepTooSmall {
+            step,
+            load_factor,
+            cause,
+            ..
+        } => format!(
+            "failed in step {} at load factor {load_factor:.3}: {}",
+            step + 1,
+            short(&cause.to_string())
+        ),
+        other => format!("failed: {}", short(&other.to_string())),
+    }
+}
+
 /// The first 80 characters of an error.
 fn short(e: &str) -> String {
     e.chars().take(80).collect()
+}
+
+/// The full load's reading, from the tips at the finest refinement (per
+/// ν, in [`RUNS`] order; `None` where a run failed).
+fn full_load_reading(finest: &[(f64, [Option<f64>; 4])]) -> String {
+    let n = REFINEMENTS[REFINEMENTS.len() - 1];
+    let mut parts = Vec::new();
+    for (nu, tips) in finest {
+        match tips {
+            [Some(ts), Some(tf), Some(gs), Some(gf)] if *nu > 0.4 => parts.push(format!(
+                "at ν = {nu} standard MPM locks: at n = {n} its tip is {:.0} % (triangles) and \
+                 {:.0} % (grid) of the treated one, while F-patch ({tf:.3}) and F-bar \
+                 ({gf:.3}) differ by {:.1} %",
+                100.0 * ts / tf,
+                100.0 * gs / gf,
+                100.0 * (tf - gf).abs() / gf
+            )),
+            [Some(ts), Some(tf), Some(gs), Some(gf)] => parts.push(format!(
+                "at ν = {nu} the treatments change the tip by {:.1} % (F-patch) and {:.1} % \
+                 (F-bar) at n = {n}",
+                100.0 * (tf - ts).abs() / ts,
+                100.0 * (gf - gs).abs() / gs
+            )),
+            _ => parts.push(format!(
+                "at ν = {nu} not every run completed at n = {n} (see the table)"
+            )),
+        }
+    }
+    format!(
+        "**Reading.** {}. Every run takes the same 10 steps; the fringe-node rule of the \
+         background runs (`weak_node_stiffness` 10⁻³, see `Traction` in \
+         `mpm_cases::locking`) holds the far nodes of cells that a lattice point has just \
+         entered alone.\n",
+        parts.join("; ")
+    )
 }
 
 /// Refinements of the footing: nodes across the 5 wide half layer (the
