@@ -241,12 +241,16 @@ fn full_load_reading(finest: &[(f64, [Option<f64>; 4])]) -> String {
             )),
         }
     }
+    let joined = parts.join("; ");
+    let mut chars = joined.chars();
+    let sentence = chars.next().map_or(String::new(), |c| {
+        c.to_uppercase().chain(chars).collect::<String>()
+    });
     format!(
-        "**Reading.** {}. Every run takes the same 10 steps; the fringe-node rule of the \
-         background runs (`weak_node_stiffness` 10⁻³, see `Traction` in \
+        "**Reading.** {sentence}. Every run takes the same 10 steps; the fringe-node rule of \
+         the background runs (`weak_node_stiffness` 10⁻³, see `Traction` in \
          `mpm_cases::locking`) holds the far nodes of cells that a lattice point has just \
-         entered alone.\n",
-        parts.join("; ")
+         entered alone.\n"
     )
 }
 
