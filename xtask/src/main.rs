@@ -11,9 +11,10 @@
 //!   `docs/src/reproduction/coombs2020.md` with PNG plots in
 //!   `docs/src/reproduction/img/` ([`coombs2020`]).
 //! - `reproduce wang2021 [--full]`: the simple stretch on tetrahedra with a
-//!   moving mesh (Table 1, standard MPM) and point location by walking
-//!   against brute force (§5.7), written to
-//!   `docs/src/reproduction/wang2021.md` ([`wang2021`]).
+//!   moving mesh (Table 1, standard MPM and F-patch), the small-deformation
+//!   footing in 3D (§5.1, Fig. 8C) and point location by walking against
+//!   brute force (§5.7), written to `docs/src/reproduction/wang2021.md`
+//!   ([`wang2021`], [`footing3d`]).
 //! - `reproduce locking`: Cook's membrane against refinement for standard
 //!   MPM, F-patch and F-bar, written to `docs/src/reproduction/locking.md`
 //!   ([`locking`]).
@@ -28,6 +29,7 @@
 
 mod column_table;
 mod coombs2020;
+mod footing3d;
 mod locking;
 mod machine;
 mod markdown;
@@ -52,8 +54,10 @@ tasks:
                 --kmax K refines the column to h = 50/2^K (2..=9, default 7)
   reproduce wang2021 [--full]
                 Wang et al. (2021): simple stretch on tetrahedra (Table 1, standard
-                MPM) and walking point location (§5.7); writes
-                docs/src/reproduction/wang2021.md. --full adds 16 subdivisions.
+                MPM and F-patch), small-deformation footing in 3D (§5.1, Fig. 8C),
+                walking point location (§5.7); writes docs/src/reproduction/wang2021.md
+                and its PNG. --full adds 16 subdivisions and runs the footing on the
+                scene's 6 x 6 x 6 mesh (4 x 4 x 4 otherwise).
   reproduce locking
                 Cook's membrane (plane strain, nu = 0.3 and 0.4999, small and full
                 load) for standard MPM, F-patch and F-bar against refinement;

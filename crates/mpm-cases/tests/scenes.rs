@@ -13,6 +13,9 @@ use proptest::prelude::*;
 
 const TWO_LAYER: &str = include_str!("../../../scenes/two_layer_column.toml");
 const SLOPE: &str = include_str!("../../../scenes/slope.toml");
+const WANG_FOOTING: &str = include_str!("../../../scenes/wang2021_footing.toml");
+/// The quick mesh of the footing scene (the xtask's quick mode too).
+const FOOTING_QUICK_MESH: &str = "mesh.coordinates=[[0.0, 0.25, 0.8, 2.1, 5.0], [0.0, 0.25, 0.8, 2.1, 5.0], [0.0, 2.9, 4.2, 4.75, 5.0]]";
 
 /// Parses, builds and runs a 2D scene.
 fn run2(text: &str, overrides: &[&str]) -> (Problem<2>, RunOutput<2>) {
@@ -387,6 +390,11 @@ fn malformed_scenes_are_refused_with_a_located_message() {
             "bad.toml:5:11: `patches` applies to kind = \"simplex\" meshes",
         ),
         (
+            "cells = [2, 2]",
+            "cells = [2, 2]\ncoordinates = [[0.0, 2.0], [0.0, 2.0]]",
+            "bad.toml:5:15: `coordinates` applies to kind = \"simplex\" meshes (a grid's cells are equal)",
+        ),
+        (
             "material = \"m\"",
             "material = \"m\"\nplacement = \"keast11\"",
             "bad.toml:16:13: placement = keast11 places points in tetrahedra",
@@ -657,6 +665,7 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/coombs2020_shear.toml"),
         include_str!("../../../scenes/wang2021_stretch.toml"),
         include_str!("../../../scenes/coombs2020_annulus.toml"),
+        WANG_FOOTING,
     ]
     .join("\n");
     let mut keys = Vec::new();
@@ -826,6 +835,116 @@ fn stretch_scene_equals_the_stretch_case() {
     // The mesh moved with the face: the top nodes are at y = 4 m.
     let top = out.last.position.iter().map(|x| x[1]).fold(0.0, f64::max);
     assert!(top > 3.8 && top < 4.0, "highest point at y = {top}");
+}
+
+/// The footing scene's rectilinear box: node rows where `coordinates`
+/// puts them (the footing edge on a node), children's mid-edge nodes at
+/// the midpoints, and the refusals of rows that describe no box.
+#[test]
+fn rectilinear_simplex_boxes_put_the_footing_edge_on_a_node() {
+    let (scene, src) = scene::parse(WANG_FOOTING, "wang2021_footing.toml", &[]).unwrap();
+    let problem = Problem::<3>::build(&scene, &src, 0).unwrap();
+    let SceneMeshKind::Simplex(mesh) = &problem.mesh else {
+        panic!("the footing runs on tetrahedra");
+    };
+    let planes = |axis: usize| {
+        let mut v: Vec<f64> = mesh.nodes().iter().map(|x| x[axis]).collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+        v
+    };
+    let expect = |rows: &[f64]| {
+        // Parent rows and the children's midpoints between them.
+        let mut v = vec![rows[0]];
+        for w in rows.windows(2) {
+            v.extend([0.5 * (w[0] + w[1]), w[1]]);
+        }
+        v
+    };
+    let (xs, zs) = (planes(0), planes(2));
+    let x_rows = expect(&[0.0, 0.125, 0.25, 0.375, 0.6, 1.1, 2.3, 5.0]);
+    let z_rows = expect(&[0.0, 2.7, 3.9, 4.4, 4.625, 4.75, 4.875, 5.0]);
+    assert_eq!(xs.len(), x_rows.len());
+    for (a, b) in xs.iter().zip(&x_rows).chain(zs.iter().zip(&z_rows)) {
+        assert!((a - b).abs() < 1e-12, "{xs:?} {zs:?}");
+    }
+    // The footing: the 5 x 5 top nodes with x, y <= 0.25; the volume kept.
+    assert_eq!(problem.reactions[0].1.len(), 25);
+    assert_eq!(mesh.element_count(), 7 * 7 * 7 * 6 * 8);
+    assert!((mesh.total_volume() - 125.0).abs() < 1e-9);
+    assert_eq!(problem.len(), 11 * mesh.element_count());
+    for (set, expect) in [
+        (
+            "mesh.coordinates=[[0.0, 5.0], [0.0, 5.0]]",
+            "mesh `coordinates` has 2 rows; the scene is 3D",
+        ),
+        (
+            "mesh.coordinates=[[0.0, 1.0, 0.5, 5.0], [0.0, 5.0], [0.0, 5.0]]",
+            "mesh `coordinates` along x: give at least two finite, strictly increasing values",
+        ),
+        (
+            "mesh.coordinates=[[0.0, 5.0], [0.0, 4.0], [0.0, 5.0]]",
+            "mesh `coordinates` along y",
+        ),
+        (
+            "mesh.cells=[2, 2, 2]",
+            "give mesh `coordinates` or `cells`/`spacing`, not both",
+        ),
+    ] {
+        let (scene, src) =
+            scene::parse(WANG_FOOTING, "wang2021_footing.toml", &[set.to_owned()]).unwrap();
+        let message = Problem::<3>::build(&scene, &src, 0)
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains(expect), "{set}: {message}");
+    }
+}
+
+/// Wang et al. 2021 §5.1 (Fig. 8C) on a coarser mesh of its scene (4
+/// parent cells per axis, one of 0.25 m under the footing, growing away
+/// from it; 10 steps of 0.2 mm): past yield the standard MPM pressure keeps
+/// rising (volumetric locking at ν = 0.48) while F-patch's levels off,
+/// below it and above the strip's 2 + π.
+#[test]
+fn wang_footing_locks_with_standard_mpm_and_levels_off_with_fpatch() {
+    let k = 0.85e6 / 2f64.sqrt();
+    let curve = |locking: &str| {
+        let set = [
+            FOOTING_QUICK_MESH.to_owned(),
+            "solver.steps=10".to_owned(),
+            format!("solver.locking=\"{locking}\""),
+        ];
+        let (scene, src) = scene::parse(WANG_FOOTING, "wang2021_footing.toml", &set).unwrap();
+        let problem = Problem::<3>::build(&scene, &src, 0).unwrap();
+        let footing = problem.reactions[0].1.clone();
+        let mut pressure = vec![0.0];
+        scene::run(&problem, &RunControl::default(), |_, rep, _| {
+            let f: f64 = rep
+                .node_reactions
+                .iter()
+                .filter(|(v, _)| footing.binary_search(v).is_ok())
+                .map(|(_, f)| f[2])
+                .sum();
+            pressure.push(f.abs() / (0.25 * 0.25) / k);
+            Ok(())
+        })
+        .unwrap();
+        pressure
+    };
+    let (standard, patched) = (curve("none"), curve("fpatch"));
+    assert_eq!(standard.len(), 11);
+    assert_eq!(patched.len(), 11);
+    // Slope of the last fifth (steps 8 to 10) over the first step's: a
+    // plateau is below 1 % of the elastic slope; standard MPM still rises
+    // at more than 5 % of it.
+    let late = |p: &[f64]| (p[10] - p[8]) / 2.0 / p[1];
+    let (s, f) = (late(&standard), late(&patched));
+    assert!(
+        s > 0.05 && f < 0.01,
+        "late slopes: standard {s}, F-patch {f}"
+    );
+    assert!(patched[10] < standard[10], "{patched:?} {standard:?}");
+    assert!(patched[10] > 2.0 + std::f64::consts::PI, "{patched:?}");
 }
 
 /// The built-in annulus case (Coombs et al. 2020 §7.4) at its defaults and

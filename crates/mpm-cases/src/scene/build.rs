@@ -462,6 +462,7 @@ impl<const D: usize> Problem<D> {
                     m.file.as_ref().map(Spanned::span),
                     m.dimension.as_ref().map(Spanned::span),
                     m.patches.as_ref().map(Spanned::span),
+                    m.coordinates.as_ref().map(Spanned::span),
                 ];
                 if let Some(span) = misplaced.into_iter().flatten().next() {
                     return Err(src.error(Some(span), "an annulus mesh takes `inner_radius`, `outer_radius`, `layers`, `ring_nodes`, `jitter` and `seed`"));
@@ -555,6 +556,9 @@ impl<const D: usize> Problem<D> {
                 if let Some(p) = m.patches.as_ref() {
                     return Err(src.at(p, "`patches` applies to kind = \"simplex\" meshes"));
                 }
+                if let Some(c) = m.coordinates.as_ref() {
+                    return Err(src.at(c, "`coordinates` applies to kind = \"simplex\" meshes (a grid's cells are equal)"));
+                }
                 let (Some(origin), Some(size)) = (&m.origin, &m.size) else {
                     return Err(src.error(
                         None,
@@ -581,6 +585,9 @@ impl<const D: usize> Problem<D> {
                 }
                 if let Some(p) = m.patches.as_ref() {
                     return Err(src.at(p, "`patches` applies to kind = \"simplex\" meshes (quadratic Gmsh elements are always split into their linear children)"));
+                }
+                if let Some(c) = m.coordinates.as_ref() {
+                    return Err(src.at(c, "`coordinates` applies to kind = \"simplex\" meshes"));
                 }
                 let Some(file) = &m.file else {
                     return Err(src.error(None, "[mesh]: a Gmsh mesh needs `file` and `dimension`"));
@@ -624,9 +631,21 @@ impl<const D: usize> Problem<D> {
                 if let Err(reason) = variant.require_simplex("a simplex mesh", patches) {
                     return Err(src.at(origin, format!("[mesh] kind = \"simplex\": {reason}")));
                 }
-                let (grid, origin_v, upper, _) = grid_mesh::<D>(m, origin, size, 0, &variant, src)?;
-                let boxed = mpm_mesh::BoxMesh::new(origin_v, upper, grid.cells_per_axis());
-                let simplices = if patches {
+                let (origin_v, upper, cells, lines) = match &m.coordinates {
+                    None => {
+                        let (grid, origin_v, upper, _) =
+                            grid_mesh::<D>(m, origin, size, 0, &variant, src)?;
+                        (origin_v, upper, grid.cells_per_axis(), None)
+                    }
+                    Some(c) => {
+                        let (origin_v, upper, lines) =
+                            coordinate_lines::<D>(m, c, origin, size, src)?;
+                        let cells = std::array::from_fn(|a| lines[a].len() - 1);
+                        (origin_v, upper, cells, Some(lines))
+                    }
+                };
+                let boxed = mpm_mesh::BoxMesh::new(origin_v, upper, cells);
+                let mut simplices = if patches {
                     boxed
                         .quadratic_mesh()
                         .and_then(|q| mpm_mesh::PatchMesh::from_parents(&q))
@@ -638,6 +657,16 @@ impl<const D: usize> Problem<D> {
                     boxed.simplex_mesh()
                 }
                 .map_err(|e| src.at(origin, format!("mesh: {e}")))?;
+                if let (Some(lines), Some(c)) = (&lines, &m.coordinates) {
+                    let moved = simplices
+                        .nodes()
+                        .iter()
+                        .map(|x| rectilinear(x, &origin_v, &upper, lines))
+                        .collect();
+                    simplices
+                        .move_nodes(moved)
+                        .map_err(|e| src.at(c, format!("mesh: {e}")))?;
+                }
                 (SceneMesh::Simplex(Box::new(simplices)), origin_v, upper, 0)
             }
         };
@@ -1639,6 +1668,92 @@ fn grid_mesh<const D: usize>(
         .map_err(|e| src.at(origin_spec, format!("mesh: {e}")))?;
     let upper = origin + size;
     Ok((grid, origin, upper, padding))
+}
+
+/// A rectilinear box: its lower and upper corners and its node rows.
+type RectilinearBox<const D: usize> = (SVector<f64, D>, SVector<f64, D>, [Vec<f64>; D]);
+
+/// The node rows of a rectilinear simplex box (`coordinates`): D strictly
+/// increasing rows from `origin` to `origin + size`, given instead of
+/// `cells` and `spacing`; with the box's corners.
+fn coordinate_lines<const D: usize>(
+    m: &super::format::MeshSpec,
+    c: &Spanned<Vec<Vec<f64>>>,
+    origin_spec: &Spanned<Vec<f64>>,
+    size_spec: &Spanned<Vec<f64>>,
+    src: &SceneSource,
+) -> Result<RectilinearBox<D>, CasesError> {
+    if m.cells.is_some() || m.spacing.is_some() {
+        return Err(src.at(
+            c,
+            "give mesh `coordinates` or `cells`/`spacing`, not both (the rows set the cells)",
+        ));
+    }
+    let origin = point::<D>(origin_spec, "mesh `origin`", src)?;
+    let size = point::<D>(size_spec, "mesh `size`", src)?;
+    let rows = c.get_ref();
+    if rows.len() != D {
+        return Err(src.at(
+            c,
+            format!(
+                "mesh `coordinates` has {} rows; the scene is {D}D (one row of node coordinates per axis)",
+                rows.len()
+            ),
+        ));
+    }
+    let mut nodes = 1usize;
+    for (a, row) in rows.iter().enumerate() {
+        let (lo, hi) = (origin[a], origin[a] + size[a]);
+        let tol = 1e-9 * size[a].abs();
+        let increasing = row.windows(2).all(|w| w[0] < w[1]);
+        let ends = row.first().is_some_and(|x| (x - lo).abs() <= tol)
+            && row.last().is_some_and(|x| (x - hi).abs() <= tol);
+        if row.len() < 2 || !increasing || !ends || row.iter().any(|x| !x.is_finite()) {
+            return Err(src.at(
+                c,
+                format!(
+                    "mesh `coordinates` along {}: give at least two finite, strictly increasing values from the origin {lo} to origin + size {hi}",
+                    AXES[a]
+                ),
+            ));
+        }
+        nodes = nodes.saturating_mul(2 * row.len() - 1);
+    }
+    if nodes > MAX_ENTITIES {
+        return Err(src.at(
+            c,
+            format!("the mesh would have more than {MAX_ENTITIES} nodes"),
+        ));
+    }
+    let lines = std::array::from_fn(|a| {
+        let mut row = rows[a].clone();
+        // The box's corners exactly, so that its faces stay the node sets.
+        row[0] = origin[a];
+        let last = row.len() - 1;
+        row[last] = origin[a] + size[a];
+        row
+    });
+    Ok((origin, origin + size, lines))
+}
+
+/// Maps a node of the uniform box `lower..upper` with `lines[a].len() - 1`
+/// cells per axis to the rectilinear box of node rows `lines`: affinely
+/// within every cell, so a cell's simplices (and the mid-edge nodes of
+/// quadratic parents) map onto the same split of the new cell.
+fn rectilinear<const D: usize>(
+    x: &SVector<f64, D>,
+    lower: &SVector<f64, D>,
+    upper: &SVector<f64, D>,
+    lines: &[Vec<f64>; D],
+) -> SVector<f64, D> {
+    SVector::<f64, D>::from_fn(|a, _| {
+        let row = &lines[a];
+        let cells = row.len() - 1;
+        let t = (x[a] - lower[a]) / (upper[a] - lower[a]) * cells as f64;
+        let i = (t.floor().max(0.0) as usize).min(cells - 1);
+        let f = t - i as f64;
+        row[i] + f * (row[i + 1] - row[i])
+    })
 }
 
 /// The manufactured fields `kind = "manufactured"` loads can name, with

@@ -103,6 +103,12 @@ pub struct MeshSpec {
     /// false: linear simplices).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub patches: Option<Spanned<bool>>,
+    /// Simplex boxes: the cells' node coordinates along each axis (m),
+    /// from `origin` to `origin + size`, strictly increasing (instead of
+    /// `cells` or `spacing`): a rectilinear box, refined where the rows
+    /// are close.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinates: Option<Spanned<Vec<Vec<f64>>>>,
     /// Annulus: inner radius (m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inner_radius: Option<Spanned<f64>>,
