@@ -13,6 +13,12 @@ use nalgebra::SVector;
 use crate::body::{Body, InitialDomain};
 use mpm_basis::Corners;
 
+/// What sees each converged step: its number, its report and the state
+/// after it. Runs take it as a trait object, so the solver behind a run is
+/// compiled once per variant, not once more for every caller's closure.
+pub type StepObserver<'a, const D: usize> =
+    dyn FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError> + 'a;
+
 /// Output quantities of a law's history.
 pub trait HistoryOutput {
     /// Equivalent plastic strain (zero for elastic laws).
@@ -285,8 +291,15 @@ where
         stepping: setup.stepping,
         newton: setup.newton,
     };
-    simulate_points::<D, B, F, U, NoLocking, L, C, O>(
-        points, analysis, basis, updater, NoLocking, control, observer,
+    let mut observer = observer;
+    simulate_points::<D, B, F, U, NoLocking, L, C>(
+        points,
+        analysis,
+        basis,
+        updater,
+        NoLocking,
+        control,
+        &mut observer,
     )
 }
 
@@ -294,14 +307,14 @@ where
 /// masses, initial histories such as material tags, loads), with the
 /// locking treatment `locking`.
 #[allow(clippy::too_many_arguments)]
-pub fn simulate_points<const D: usize, B, F, U, K, L, C, O>(
+pub fn simulate_points<const D: usize, B, F, U, K, L, C>(
     mut points: MaterialPoints<D, L::History, B::Domain>,
     analysis: Analysis<B::Mesh, L, C>,
     basis: B,
     updater: U,
     locking: K,
     control: &RunControl,
-    mut observer: O,
+    observer: &mut StepObserver<'_, D>,
 ) -> Result<RunOutput<D>, SolverError>
 where
     B: InitialDomain<D>,
@@ -313,7 +326,6 @@ where
     L: LogStrainLaw,
     L::History: HistoryOutput + Flat,
     C: Constraints<D>,
-    O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
     let setup = analysis;
     let moves_mesh = setup.constraints.moves_mesh();

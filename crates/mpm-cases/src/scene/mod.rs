@@ -66,7 +66,7 @@ mod runner;
 pub use build::{Problem, SceneConstraints};
 pub use format::Scene;
 pub use program::run_file;
-pub use runner::run;
+pub use runner::{RunScene, run};
 
 use crate::CasesError;
 use crate::scene_file::{SceneSource, parse_scene_located};

@@ -32,7 +32,10 @@ fn scene_run_in<const D: usize>(
     scene: &crate::scene::Scene,
     source: &crate::scene_file::SceneSource,
     session: &Session,
-) -> Result<(), CasesError> {
+) -> Result<(), CasesError>
+where
+    crate::scene::Problem<D>: crate::scene::RunScene<D>,
+{
     use crate::scene::Problem;
 
     let problem = Problem::<D>::build_in(
@@ -57,7 +60,10 @@ fn scene_run_on<const D: usize, M: CellMesh<D>>(
     problem: &crate::scene::Problem<D>,
     session: &Session,
     mesh: M,
-) -> Result<(), CasesError> {
+) -> Result<(), CasesError>
+where
+    crate::scene::Problem<D>: crate::scene::RunScene<D>,
+{
     use crate::output::CsvValue;
     use crate::writer::VtuOptions;
 

@@ -18,13 +18,20 @@ use nalgebra::SVector;
 use crate::body::InitialDomain;
 use crate::material::{LawVisitor, MaterialTag, dispatch_law, dispatch_law_set};
 use crate::run::{
-    Analysis, DomainBounds, HistoryOutput, RunControl, RunOutput, Snapshot, simulate_points,
+    Analysis, DomainBounds, HistoryOutput, RunControl, RunOutput, Snapshot, StepObserver,
+    simulate_points,
 };
 use crate::variant::{FormulationKind, LockingKind, VariantVisitor, dispatch};
 
 use super::build::{Problem, SceneMesh};
 
 /// Runs `problem`; `observer` sees every converged step.
+///
+/// The solvers behind a scene (every variant × law × locking treatment)
+/// are compiled once per dimension, in this crate, through
+/// [`RunScene`]: a caller's closure reaches them as a
+/// [`StepObserver`] trait object, so neither this crate's cases nor a
+/// downstream binary compiles the matrix again.
 ///
 /// # Errors
 /// [`SolverError::InvalidInput`] for a variant that does not exist (e.g.
@@ -33,11 +40,58 @@ use super::build::{Problem, SceneMesh};
 pub fn run<const D: usize, O>(
     problem: &Problem<D>,
     control: &RunControl,
-    observer: O,
+    mut observer: O,
 ) -> Result<RunOutput<D>, SolverError>
 where
+    Problem<D>: RunScene<D>,
     O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
+    problem.run_scene(control, &mut observer)
+}
+
+/// A scene problem that runs: implemented for two and three dimensions,
+/// each implementation the one place where that dimension's solvers are
+/// monomorphised.
+pub trait RunScene<const D: usize> {
+    /// Runs the problem; `observer` sees every converged step.
+    ///
+    /// # Errors
+    /// As [`run`].
+    fn run_scene(
+        &self,
+        control: &RunControl,
+        observer: &mut StepObserver<'_, D>,
+    ) -> Result<RunOutput<D>, SolverError>;
+}
+
+impl RunScene<2> for Problem<2> {
+    #[inline(never)]
+    fn run_scene(
+        &self,
+        control: &RunControl,
+        observer: &mut StepObserver<'_, 2>,
+    ) -> Result<RunOutput<2>, SolverError> {
+        run_in(self, control, observer)
+    }
+}
+
+impl RunScene<3> for Problem<3> {
+    #[inline(never)]
+    fn run_scene(
+        &self,
+        control: &RunControl,
+        observer: &mut StepObserver<'_, 3>,
+    ) -> Result<RunOutput<3>, SolverError> {
+        run_in(self, control, observer)
+    }
+}
+
+/// [`run`] in dimension `D`: dispatches the variant and the law.
+fn run_in<const D: usize>(
+    problem: &Problem<D>,
+    control: &RunControl,
+    observer: &mut StepObserver<'_, D>,
+) -> Result<RunOutput<D>, SolverError> {
     match &problem.mesh {
         SceneMesh::Grid(grid) => dispatch(
             &problem.variant,
@@ -96,17 +150,14 @@ where
     }
 }
 
-struct WithVariant<'a, const D: usize, M, O> {
+struct WithVariant<'a, 'o, const D: usize, M> {
     problem: &'a Problem<D>,
     mesh: &'a M,
     control: &'a RunControl,
-    observer: O,
+    observer: &'a mut StepObserver<'o, D>,
 }
 
-impl<const D: usize, O> VariantVisitor<D> for WithVariant<'_, D, RegularGrid<D>, O>
-where
-    O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
-{
+impl<const D: usize> VariantVisitor<D> for WithVariant<'_, '_, D, RegularGrid<D>> {
     type Output = Result<RunOutput<D>, SolverError>;
 
     fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
@@ -123,10 +174,9 @@ where
     }
 }
 
-impl<const D: usize, M, O> WithVariant<'_, D, M, O>
+impl<const D: usize, M> WithVariant<'_, '_, D, M>
 where
     M: MovableMesh<D> + Clone,
-    O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
     /// Runs with basis `B` (on mesh `M`), formulation `F`, updater `U`,
     /// locking treatment `K` and the scene's materials.
@@ -139,7 +189,7 @@ where
     {
         let materials = &self.problem.materials;
         let model = materials[0].model;
-        let with_law = WithLaw::<D, M, B, F, U, K, O> {
+        let with_law = WithLaw::<D, M, B, F, U, K> {
             run: self,
             basis,
             updater,
@@ -155,22 +205,21 @@ where
     }
 }
 
-struct WithLaw<'a, const D: usize, M, B, F, U, K, O> {
-    run: WithVariant<'a, D, M, O>,
+struct WithLaw<'a, 'o, const D: usize, M, B, F, U, K> {
+    run: WithVariant<'a, 'o, D, M>,
     basis: B,
     updater: U,
     locking: K,
     formulation: std::marker::PhantomData<F>,
 }
 
-impl<const D: usize, M, B, F, U, K, O> LawVisitor for WithLaw<'_, D, M, B, F, U, K, O>
+impl<const D: usize, M, B, F, U, K> LawVisitor for WithLaw<'_, '_, D, M, B, F, U, K>
 where
     M: MovableMesh<D> + Clone,
     B: InitialDomain<D, Mesh = M, Domain: Flat + DomainBounds<D>>,
     F: Formulation,
     U: DomainUpdater<D, B::Domain>,
     K: LockingTreatment<D, M>,
-    O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
     type Output = Result<RunOutput<D>, SolverError>;
 
@@ -215,7 +264,7 @@ where
             stepping: p.stepping,
             newton: p.newton,
         };
-        simulate_points::<D, B, F, U, K, L, _, _>(
+        simulate_points::<D, B, F, U, K, L, _>(
             points,
             analysis,
             self.basis,
