@@ -147,7 +147,7 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
         snap: &Snapshot,
     ) -> Result<(), SolverError> {
         let residual = report.residuals.last().copied().unwrap_or(0.0);
-        let line = format!(
+        let mut line = format!(
             "step {} to load factor {:.4} (increment {:.3e}): {} iterations, residual {:.2e}",
             step + 1,
             report.lambda1,
@@ -155,6 +155,12 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
             report.iterations(),
             residual
         );
+        if report.at_rounding_floor {
+            line += &format!(
+                " (stalled at the rounding floor {:.2e})",
+                report.rounding_floor
+            );
+        }
         if self.plain {
             eprintln!("{line}");
         } else {

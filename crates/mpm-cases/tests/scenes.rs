@@ -280,6 +280,11 @@ fn malformed_scenes_are_refused_with_a_located_message() {
             "bad.toml:5:1: unknown field `spacings`",
         ),
         (
+            "steps = 2",
+            "steps = 18446744073709551615",
+            "bad.toml:27:9: load increments below 1e-12 would not move the load factor (min_increment 5.293955920339377e-23: 1/steps / 1024 by default)",
+        ),
+        (
             "youngs_modulus = 1e6",
             "youngs_modulus = \"stiff\"",
             "bad.toml:9:18: invalid type: string \"stiff\", expected f64",
@@ -945,6 +950,60 @@ fn wang_footing_locks_with_standard_mpm_and_levels_off_with_fpatch() {
     );
     assert!(patched[10] < standard[10], "{patched:?} {standard:?}");
     assert!(patched[10] > 2.0 + std::f64::consts::PI, "{patched:?}");
+}
+
+/// A graded footing mesh on which Newton used to stall: with 0.1 mm steps
+/// on a 10 GPa cube the reactions are so small that the rounding noise of
+/// the out-of-balance force (about 1.5e-9 of them with F-patch, 4e-10 with
+/// standard MPM) sits above the 1e-9 tolerance of eq. (40), and every
+/// step was cut down to failure. Newton converges quadratically down to
+/// that floor and the monitor accepts the stalled iterate there, with the
+/// floor it estimated. (Elastic: with the scene's yield stress the 0.1 mm
+/// step is 20 times the yield strain at the footing edge and is cut.)
+#[test]
+fn footing_steps_stalled_at_the_rounding_floor_are_accepted() {
+    let set = [
+        "material.0.yield_stress=1e15".to_owned(),
+        "mesh.coordinates=[[0.0, 0.125, 0.25, 0.375, 1.5, 5.0], [0.0, 0.125, 0.25, 0.375, 1.5, 5.0], [0.0, 3.5, 4.2, 4.625, 4.75, 4.875, 5.0]]".to_owned(),
+        "solver.locking=\"fpatch\"".to_owned(),
+    ];
+    let (scene, src) = scene::parse(WANG_FOOTING, "wang2021_footing.toml", &set).unwrap();
+    let problem = Problem::<3>::build(&scene, &src, 0).unwrap();
+    let mut reports = Vec::new();
+    let stop = scene::run(&problem, &RunControl::default(), |step, rep, _| {
+        reports.push(rep.clone());
+        if step == 1 {
+            return Err(mpm_solver::SolverError::Stopped {
+                step: 2,
+                load_factor: rep.lambda1,
+            });
+        }
+        Ok(())
+    });
+    assert!(matches!(stop, Err(mpm_solver::SolverError::Stopped { .. })));
+    assert_eq!(reports.len(), 2);
+    for rep in &reports {
+        // No step was cut: each is the scene's 1/20.
+        assert!((rep.lambda1 - rep.lambda0 - 0.05).abs() < 1e-12);
+        let r = &rep.residuals;
+        let last = *r.last().unwrap();
+        assert!(rep.at_rounding_floor, "{r:?}");
+        // Above the tolerance (the floor was needed) and within ten times
+        // the estimated floor, reached in a handful of iterations after a
+        // quadratic descent (1.6e-3 -> 4e-8 measured).
+        assert!(
+            last > 1e-9 && last <= 10.0 * rep.rounding_floor,
+            "{r:?} floor {}",
+            rep.rounding_floor
+        );
+        assert!(
+            rep.rounding_floor > 1e-10 && rep.rounding_floor < 1e-8,
+            "{}",
+            rep.rounding_floor
+        );
+        assert!(r.len() <= 6, "{r:?}");
+        assert!(r[2] < r[1] * r[1] * 1e-1, "{r:?}");
+    }
 }
 
 /// The built-in annulus case (Coombs et al. 2020 §7.4) at its defaults and

@@ -7,6 +7,12 @@ use crate::error::SolverError;
 use crate::implicit::{FreeStiffness, ImplicitSolver, StepError, StepReport};
 use crate::parts::{PointsOf, SolverParts};
 
+/// The smallest load increment an analysis accepts. The load factor in
+/// [0, 1] resolves about 1e-16, so far smaller increments would not move it
+/// at all (a run that never ends), and steps of 1e-12 already take 1e12
+/// of them; a minimum below this is refused as invalid input.
+pub const MIN_LOAD_INCREMENT: f64 = 1e-12;
+
 /// Load-factor increments: the analysis takes the load factor from 0 to 1.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LoadStepping {
@@ -118,12 +124,12 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             &StepContext<'_, P::Mesh>,
         ) -> Result<(), SolverError>,
     {
-        if !(stepping.min > 0.0
+        if !(stepping.min >= MIN_LOAD_INCREMENT
             && stepping.min <= stepping.initial
             && stepping.initial <= stepping.max)
         {
             return Err(SolverError::InvalidInput(format!(
-                "load stepping needs 0 < min <= initial <= max, got {stepping:?}"
+                "load stepping needs {MIN_LOAD_INCREMENT:e} <= min <= initial <= max, got {stepping:?}"
             )));
         }
         if !(state.load_factor.is_finite()

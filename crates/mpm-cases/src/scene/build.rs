@@ -1487,6 +1487,19 @@ impl<const D: usize> Problem<D> {
                 &format!("load increments need min_increment ({min}) <= 1/steps ({initial}) <= max_increment ({max}) <= 1"),
             ));
         }
+        if min < mpm_solver::MIN_LOAD_INCREMENT {
+            let at = s
+                .min_increment
+                .as_ref()
+                .map_or(s.steps.span(), Spanned::span);
+            return Err(src.error(
+                Some(at),
+                &format!(
+                    "load increments below {:e} would not move the load factor (min_increment {min:e}: 1/steps / 1024 by default)",
+                    mpm_solver::MIN_LOAD_INCREMENT
+                ),
+            ));
+        }
         let tolerance = check.positive(&s.tolerance, "solver `tolerance`")?;
         let max_iterations = check.at_least(&s.max_iterations, 1, "solver `max_iterations`")?;
 

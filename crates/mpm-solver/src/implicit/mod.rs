@@ -183,7 +183,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         self.prepare_step(points, lambda0, lambda1)?;
         self.predict(lambda1 - lambda0);
         let o = &self.options;
-        let mut monitor = NewtonMonitor::new(o.tolerance, o.divergence_factor, o.max_iterations);
+        let mut monitor = NewtonMonitor::new(o.tolerance, o.divergence_factor, o.max_iterations)
+            .with_rounding_floor(o.rounding_floor_factor);
         let mut backtracked = Vec::new();
         let mut initial_unbalance = None;
         let retry = |cause, monitor: &NewtonMonitor| StepError::Retry {
@@ -209,6 +210,13 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             }
             self.update_tangents(points)
                 .map_err(|cause| retry(cause, &monitor))?;
+            if iteration == 0 {
+                monitor.set_rounding_noise(convergence::rounding_noise(
+                    &self.system,
+                    self.force_gradients(),
+                    &self.it.tangent_w,
+                ));
+            }
             self.assemble_stiffness();
             self.solve()
                 .map_err(|source| retry(StepFailure::LinearSolve { source }, &monitor))?;
@@ -223,6 +231,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         Ok(StepReport {
             lambda0,
             lambda1,
+            rounding_floor: monitor.rounding_floor(),
+            at_rounding_floor: monitor.at_rounding_floor(),
             residuals: monitor.into_residuals(),
             initial_unbalance,
             reaction,

@@ -15,6 +15,14 @@ pub struct StepReport<const D: usize> {
     pub lambda1: f64,
     /// Normalised residual (eq. 40) at iterations 0, 1, ...
     pub residuals: Vec<f64>,
+    /// The rounding noise of the residual normalised like it
+    /// ([`crate::stages::convergence::rounding_noise`]): the smallest
+    /// normalised residual the step could be expected to reach (zero when
+    /// it converged without assembling a stiffness).
+    pub rounding_floor: f64,
+    /// Whether the step was accepted at that floor, stalled above the
+    /// tolerance ([`crate::NewtonOptions::rounding_floor_factor`]).
+    pub at_rounding_floor: bool,
     /// The out-of-balance force at iteration 0 measured before the
     /// reactions are known, $\|f^{ext} - f^{int}\| / \|f^{ext}\|$ over
     /// every active dof, prescribed ones included: the first residual the

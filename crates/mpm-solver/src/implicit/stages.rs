@@ -266,7 +266,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
 
     /// The basis gradients of the force and stiffness: the step's, or
     /// mapped by eq. (8) for formulations that map them.
-    fn force_gradients(&self) -> &[SVector<f64, D>] {
+    pub(super) fn force_gradients(&self) -> &[SVector<f64, D>] {
         if <P::Formulation as Formulation>::MAPS_GRADIENTS {
             &self.it.mapped
         } else {

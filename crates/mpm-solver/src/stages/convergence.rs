@@ -1,6 +1,7 @@
 //! The out-of-balance force, the reactions and the Newton convergence test
 //! (Coombs et al. 2020 eq. 40).
 
+use mpm_constitutive::tensor::Tensor4;
 use nalgebra::SVector;
 
 use crate::error::StepFailure;
@@ -94,6 +95,45 @@ pub fn node_reactions<const D: usize>(
     out
 }
 
+/// A bound on the rounding noise of the out-of-balance force over the free
+/// dofs, from the weighted tangents `tangent_w` ($T_p$, volume included)
+/// and the force gradients `grads`. The law evaluates each point's stress
+/// from a strain whose components carry an absolute rounding error of the
+/// order of the unit round-off $u$ (logarithms and eigenvalues of tensors
+/// near the identity), so the stress carries $\|\delta\tau_p\|\lesssim
+/// u\,\|T_p\|_F$ whatever the strain level, and node $v$'s force at most
+/// $e_v = u\sum_p\|T_p\|_F\,|\nabla S_{vp}|$; the bound is the norm of
+/// $e_v$ over the free dofs. Small load steps on stiff or nearly
+/// incompressible bodies (a 0.1 mm footing increment on a 10 GPa cube)
+/// have reactions so small beside it that eq. (40) cannot reach a
+/// tolerance of $10^{-9}$: see [`NewtonMonitor::set_rounding_noise`].
+pub fn rounding_noise<const D: usize>(
+    sys: &StepSystem<D>,
+    grads: &[SVector<f64, D>],
+    tangent_w: &[Tensor4],
+) -> f64 {
+    let mut bound = vec![0.0; sys.n_active()];
+    for (p, t) in tangent_w.iter().enumerate() {
+        let norm = t.norm();
+        for s in sys.slots(p) {
+            bound[sys.nodes[s] as usize] += norm * grads[s].norm();
+        }
+    }
+    let b2: f64 = sys
+        .free_of_dof
+        .iter()
+        .enumerate()
+        .filter(|&(_, &free)| free != NONE)
+        .map(|(dof, _)| bound[dof / D] * bound[dof / D])
+        .sum();
+    0.5 * f64::EPSILON * b2.sqrt()
+}
+
+/// A Newton iteration has stalled when it removes less than this fraction
+/// of the residual ([`NewtonMonitor::check`] then accepts a residual at
+/// the rounding floor).
+pub const STALL_RATIO: f64 = 0.5;
+
 /// What the convergence test says after an iteration.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Verdict {
@@ -110,6 +150,16 @@ pub enum Verdict {
 /// solution is stress free — a rigid motion imposed on the boundary — the
 /// reactions vanish with the residual and the plain ratio would stay of
 /// order one), with divergence and iteration limits.
+///
+/// Given the rounding noise of the residual
+/// ([`Self::set_rounding_noise`], from [`rounding_noise`]), the test also
+/// accepts an iterate whose out-of-balance force is within
+/// `floor_factor` times that noise once Newton has stalled (the last
+/// iteration removed less than [`STALL_RATIO`] of the residual): below the
+/// noise no iteration can reduce it further, and eq. (40) alone would cut
+/// such steps down to failure although they are solved to the accuracy
+/// floating point allows. [`Self::at_rounding_floor`] says when that
+/// happened.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NewtonMonitor {
     tolerance: f64,
@@ -117,6 +167,9 @@ pub struct NewtonMonitor {
     max_iterations: usize,
     force_scale: f64,
     residuals: Vec<f64>,
+    floor_factor: f64,
+    noise: f64,
+    at_floor: bool,
 }
 
 impl NewtonMonitor {
@@ -130,7 +183,37 @@ impl NewtonMonitor {
             max_iterations,
             force_scale: 0.0,
             residuals: Vec::new(),
+            floor_factor: 0.0,
+            noise: 0.0,
+            at_floor: false,
         }
+    }
+
+    /// Accept stalled iterates within `floor_factor` times the rounding
+    /// noise of the residual (zero, the default of [`Self::new`], keeps
+    /// eq. (40) alone).
+    pub fn with_rounding_floor(mut self, floor_factor: f64) -> Self {
+        self.floor_factor = floor_factor;
+        self
+    }
+
+    /// The rounding noise of $\|f^R\|$ (absolute, [`rounding_noise`]) for
+    /// the checks that follow.
+    pub fn set_rounding_noise(&mut self, noise: f64) {
+        self.noise = noise;
+    }
+
+    /// The rounding noise normalised like the residual, i.e. the smallest
+    /// normalised residual the step can be expected to reach (zero until
+    /// [`Self::set_rounding_noise`]).
+    pub fn rounding_floor(&self) -> f64 {
+        ratio(self.noise, self.force_scale)
+    }
+
+    /// Whether the step was accepted at the rounding floor rather than by
+    /// the tolerance.
+    pub fn at_rounding_floor(&self) -> bool {
+        self.at_floor
     }
 
     /// Records the residual parts `(‖f^R‖, ‖f^ext + f^react‖)` of the
@@ -141,6 +224,11 @@ impl NewtonMonitor {
         let residual = ratio(residual_norm, self.force_scale);
         self.residuals.push(residual);
         if residual <= self.tolerance {
+            return Verdict::Converged;
+        }
+        let stalled = iteration > 0 && residual >= STALL_RATIO * self.residuals[iteration - 1];
+        if stalled && residual_norm <= self.floor_factor * self.noise {
+            self.at_floor = true;
             return Verdict::Converged;
         }
         if !residual.is_finite()
@@ -207,5 +295,40 @@ mod tests {
         assert_eq!(m.residuals(), &[0.5, 5e-11]);
         assert_eq!(ratio(0.0, 0.0), 0.0);
         assert_eq!(ratio(1.0, 0.0), f64::INFINITY);
+    }
+
+    #[test]
+    fn a_stalled_residual_within_the_rounding_noise_is_accepted() {
+        // Noise 1e-9 in a force of 1 (normalised floor 1e-9), tolerance
+        // 1e-12, floor factor 10.
+        let monitor = || {
+            let mut m = NewtonMonitor::new(1e-12, 1e6, 30).with_rounding_floor(10.0);
+            assert_eq!(m.check(1.0, 1.0), Verdict::Continue);
+            m.set_rounding_noise(1e-9);
+            m
+        };
+        // Still falling fast below the floor: iterate on.
+        let mut m = monitor();
+        assert_eq!(m.check(1e-3, 1.0), Verdict::Continue);
+        assert_eq!(m.check(5e-9, 1.0), Verdict::Continue);
+        // Stalled within 10 x noise: accepted at the floor.
+        assert_eq!(m.check(4e-9, 1.0), Verdict::Converged);
+        assert!(m.at_rounding_floor());
+        assert_eq!(m.rounding_floor(), 1e-9);
+        // Stalled above 10 x noise: not accepted.
+        let mut m = monitor();
+        assert_eq!(m.check(3e-8, 1.0), Verdict::Continue);
+        assert_eq!(m.check(2e-8, 1.0), Verdict::Continue);
+        assert!(!m.at_rounding_floor());
+        // Without the factor (the plain eq. 40 test) nothing changes.
+        let mut m = NewtonMonitor::new(1e-12, 1e6, 30);
+        m.set_rounding_noise(1e-9);
+        assert_eq!(m.check(1.0, 1.0), Verdict::Continue);
+        assert_eq!(m.check(2e-9, 1.0), Verdict::Continue);
+        assert_eq!(m.check(2e-9, 1.0), Verdict::Continue);
+        // Below the tolerance the step converges by eq. (40), not the floor.
+        let mut m = monitor();
+        assert_eq!(m.check(1e-13, 1.0), Verdict::Converged);
+        assert!(!m.at_rounding_floor());
     }
 }
