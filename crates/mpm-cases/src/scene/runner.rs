@@ -64,27 +64,23 @@ pub trait RunScene<const D: usize> {
     ) -> Result<RunOutput<D>, SolverError>;
 }
 
-impl RunScene<2> for Problem<2> {
-    #[inline(never)]
-    fn run_scene(
-        &self,
-        control: &RunControl,
-        observer: &mut StepObserver<'_, 2>,
-    ) -> Result<RunOutput<2>, SolverError> {
-        run_in(self, control, observer)
-    }
+/// The two dimensions' implementations, each compiled once, here.
+macro_rules! run_scene_in {
+    ($($d:literal),*) => {$(
+        impl RunScene<$d> for Problem<$d> {
+            #[inline(never)]
+            fn run_scene(
+                &self,
+                control: &RunControl,
+                observer: &mut StepObserver<'_, $d>,
+            ) -> Result<RunOutput<$d>, SolverError> {
+                run_in(self, control, observer)
+            }
+        }
+    )*};
 }
 
-impl RunScene<3> for Problem<3> {
-    #[inline(never)]
-    fn run_scene(
-        &self,
-        control: &RunControl,
-        observer: &mut StepObserver<'_, 3>,
-    ) -> Result<RunOutput<3>, SolverError> {
-        run_in(self, control, observer)
-    }
-}
+run_scene_in!(2, 3);
 
 /// [`run`] in dimension `D`: dispatches the variant and the law.
 fn run_in<const D: usize>(
