@@ -12,9 +12,10 @@
 //!   `docs/src/reproduction/img/` ([`coombs2020`]).
 //! - `reproduce wang2021 [--full]`: the simple stretch on tetrahedra with a
 //!   moving mesh (Table 1, standard MPM and F-patch), the small-deformation
-//!   footing in 3D (§5.1, Fig. 8C) and point location by walking against
-//!   brute force (§5.7), written to `docs/src/reproduction/wang2021.md`
-//!   ([`wang2021`], [`footing3d`]).
+//!   footing in 3D (§5.1, Fig. 8C), the vane slice (§5.5, Fig. 18C) and
+//!   point location by walking against brute force (§5.7), written to
+//!   `docs/src/reproduction/wang2021.md` ([`wang2021`], [`footing3d`],
+//!   [`vane`]).
 //! - `reproduce locking`: Cook's membrane against refinement for standard
 //!   MPM, F-patch and F-bar, written to `docs/src/reproduction/locking.md`
 //!   ([`locking`]).
@@ -35,6 +36,7 @@ mod machine;
 mod markdown;
 mod plot;
 mod reference_values;
+mod vane;
 mod wang2021;
 
 use std::path::{Path, PathBuf};

@@ -597,12 +597,7 @@ where
     let start = std::time::Instant::now();
     let mut curve = FootingCurve::default();
     let result = solver.run(&mut points, &LoadStepping::uniform(f.steps), |_, r, _| {
-        let force: f64 = r
-            .node_reactions
-            .iter()
-            .filter(|(node, _)| footing.binary_search(node).is_ok())
-            .map(|(_, v)| v[1])
-            .sum();
+        let force = r.reaction_on(footing)[1];
         curve
             .points
             .push((r.lambda1 * f.settlement, -force / HALF_WIDTH));

@@ -637,8 +637,19 @@ fn features_scene_runs_with_every_remaining_key() {
             .iter()
             .all(|x| (x - nalgebra::Vector2::new(2.0, 1.0)).norm() > 0.5)
     );
-    let pulled: Vec<f64> = out.reports.iter().map(|r| r.reaction[0]).collect();
+    // The pulled end's own reaction (the sum over every prescribed dof is
+    // the body's x balance, zero to the tolerance).
+    let end = problem
+        .reactions
+        .iter()
+        .find(|r| r.name == "pulled")
+        .unwrap();
+    let pulled: Vec<f64> = out.reports.iter().map(|r| end.total(r)[0]).collect();
+    assert!(pulled[0] > 0.0, "{pulled:?}");
     assert!(pulled.windows(2).all(|w| w[1] > w[0]), "{pulled:?}");
+    for r in &out.reports {
+        assert!(r.reaction[0].abs() < 1e-6 * pulled[pulled.len() - 1]);
+    }
     let dir = run_mpm("features.toml", "features_scene");
     let vtu = std::fs::read_to_string(dir.join("points_0002.vtu")).unwrap();
     for (name, wanted) in [
@@ -671,6 +682,7 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/wang2021_stretch.toml"),
         include_str!("../../../scenes/coombs2020_annulus.toml"),
         WANG_FOOTING,
+        include_str!("../../../scenes/wang2021_vane_slice.toml"),
     ]
     .join("\n");
     let mut keys = Vec::new();
@@ -874,7 +886,7 @@ fn rectilinear_simplex_boxes_put_the_footing_edge_on_a_node() {
         assert!((a - b).abs() < 1e-12, "{xs:?} {zs:?}");
     }
     // The footing: the 5 x 5 top nodes with x, y <= 0.25; the volume kept.
-    assert_eq!(problem.reactions[0].1.len(), 25);
+    assert_eq!(problem.reactions[0].nodes.len(), 25);
     assert_eq!(mesh.element_count(), 7 * 7 * 7 * 6 * 8);
     assert!((mesh.total_volume() - 125.0).abs() < 1e-9);
     assert_eq!(problem.len(), 11 * mesh.element_count());
@@ -921,15 +933,10 @@ fn wang_footing_locks_with_standard_mpm_and_levels_off_with_fpatch() {
         ];
         let (scene, src) = scene::parse(WANG_FOOTING, "wang2021_footing.toml", &set).unwrap();
         let problem = Problem::<3>::build(&scene, &src, 0).unwrap();
-        let footing = problem.reactions[0].1.clone();
+        let footing = problem.reactions[0].clone();
         let mut pressure = vec![0.0];
         scene::run(&problem, &RunControl::default(), |_, rep, _| {
-            let f: f64 = rep
-                .node_reactions
-                .iter()
-                .filter(|(v, _)| footing.binary_search(v).is_ok())
-                .map(|(_, f)| f[2])
-                .sum();
+            let f = footing.total(rep)[2];
             pressure.push(f.abs() / (0.25 * 0.25) / k);
             Ok(())
         })
@@ -990,19 +997,30 @@ fn footing_steps_stalled_at_the_rounding_floor_are_accepted() {
         assert!(rep.at_rounding_floor, "{r:?}");
         // Above the tolerance (the floor was needed) and within ten times
         // the estimated floor, reached in a handful of iterations after a
-        // quadratic descent (1.6e-3 -> 4e-8 measured).
+        // quadratic descent (measured: 1.3e-3 at iteration 0, after the
+        // linearised first solve, then 3.0e-8 and 2.6e-8 at the floor).
         assert!(
             last > 1e-9 && last <= 10.0 * rep.rounding_floor,
             "{r:?} floor {}",
             rep.rounding_floor
         );
+        // The floor is normalised by the largest reaction of the step's
+        // iterations; since the first solve is linearised about the
+        // converged state (FirstTangent::Converged) that is the converged
+        // reaction, not the stiffer one of the prescribed settlement alone
+        // at iteration 0, so the floor reads about 20 times higher than
+        // with plain Newton (measured 2.9e-8 against 1.5e-9).
         assert!(
-            rep.rounding_floor > 1e-10 && rep.rounding_floor < 1e-8,
+            rep.rounding_floor > 1e-9 && rep.rounding_floor < 1e-7,
             "{}",
             rep.rounding_floor
         );
-        assert!(r.len() <= 6, "{r:?}");
-        assert!(r[2] < r[1] * r[1] * 1e-1, "{r:?}");
+        // The elastic step's first solve, linearised about the converged
+        // state, leaves only the geometric nonlinearity (1.3e-3), and one
+        // Newton correction reaches the floor.
+        assert!(rep.linearised_start);
+        assert!(r[0] < 1e-2, "{r:?}");
+        assert!(r.len() <= 4, "{r:?}");
     }
 }
 

@@ -90,7 +90,8 @@ pub use error::{
 };
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
 pub use implicit::{
-    FreeStiffness, ImplicitBuilder, ImplicitSolver, NewtonOptions, StepError, StepReport,
+    FirstTangent, FreeStiffness, ImplicitBuilder, ImplicitSolver, NewtonOptions, StepError,
+    StepReport,
 };
 pub use linear::{Factorisation, FaerDirect, LinearSolveError, LinearSolver};
 pub use locking::{FBar, FPatch, LockingTreatment, NoLocking, PatchAssignment, PatchInput};

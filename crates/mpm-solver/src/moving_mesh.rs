@@ -94,6 +94,36 @@ impl Rotation<3> {
 }
 
 impl<const D: usize> Rotation<D> {
+    /// Right-handed rotation about the coordinate axis `axis` through
+    /// `centre`: $K_{ik} = \varepsilon_{i\,a\,k}$ with $a$ the axis, which in
+    /// 2D (`axis` = 2, the out-of-plane axis) is the counter-clockwise plane
+    /// rotation. `None` unless `axis` < 3 in 3D or `axis` = 2 in 2D.
+    pub fn about_coordinate_axis(centre: SVector<f64, D>, axis: usize, angle: f64) -> Option<Self> {
+        let valid = match D {
+            2 => axis == 2,
+            3 => axis < 3,
+            _ => false,
+        };
+        if !valid {
+            return None;
+        }
+        let levi_civita = |i: usize, j: usize, k: usize| -> f64 {
+            // (i, j, k) a permutation of (0, 1, 2): its sign; else 0.
+            if i == j || j == k || i == k {
+                0.0
+            } else if (i + 1) % 3 == j {
+                1.0
+            } else {
+                -1.0
+            }
+        };
+        Some(Self {
+            centre,
+            generator: SMatrix::<f64, D, D>::from_fn(|i, k| levi_civita(i, axis, k)),
+            angle,
+        })
+    }
+
     /// $\mathbf R(\varphi)$.
     pub fn matrix(&self, phi: f64) -> SMatrix<f64, D, D> {
         let k = &self.generator;
@@ -265,6 +295,30 @@ mod tests {
     use crate::boundary::NodalConstraints;
     use mpm_mesh::{BoxMesh, RegularGrid};
     use nalgebra::{Vector2, Vector3};
+
+    #[test]
+    fn coordinate_axis_rotations_match_the_explicit_constructors() {
+        let c2 = Vector2::new(0.3, -0.2);
+        let r2 = Rotation::<2>::about_coordinate_axis(c2, 2, 0.7).expect("z in 2D");
+        assert_eq!(r2, Rotation::planar(c2, 0.7));
+        let c3 = Vector3::new(0.1, 0.2, 0.3);
+        for axis in 0..3 {
+            let r = Rotation::<3>::about_coordinate_axis(c3, axis, -0.4).expect("axis < 3");
+            let expected = Rotation::about_axis(
+                c3,
+                Vector3::from_fn(|i, _| f64::from(u8::from(i == axis))),
+                -0.4,
+            )
+            .expect("a unit axis");
+            assert!((r.matrix(0.9) - expected.matrix(0.9)).norm() < 1e-15);
+            // Right-handed: a quarter turn about z takes x to y.
+        }
+        let z = Rotation::<3>::about_coordinate_axis(Vector3::zeros(), 2, 1.0).expect("z");
+        let y = z.matrix(std::f64::consts::FRAC_PI_2) * Vector3::x();
+        assert!((y - Vector3::y()).norm() < 1e-15);
+        assert!(Rotation::<2>::about_coordinate_axis(c2, 0, 1.0).is_none());
+        assert!(Rotation::<3>::about_coordinate_axis(c3, 3, 1.0).is_none());
+    }
 
     #[test]
     fn motions_are_functions_of_the_load_factor() {

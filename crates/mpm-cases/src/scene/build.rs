@@ -8,8 +8,8 @@ use std::collections::BTreeMap;
 
 use mpm_mesh::{RegularGrid, SimplexMesh};
 use mpm_solver::{
-    BodyForcePath, Constraints, LoadStepping, MeshMotionError, MovableMesh, MovingMesh,
-    NewtonOptions, StepView, Stretch,
+    BodyForcePath, Constraints, LoadStepping, MeshMotion, MeshMotionError, MovableMesh, MovingMesh,
+    NewtonOptions, Rotation, StepView, Stretch,
 };
 use nalgebra::SVector;
 use toml::Spanned;
@@ -77,7 +77,7 @@ pub struct SceneConstraints<const D: usize> {
     dofs: Vec<Option<(f64, u16)>>,
     curves: Vec<Curve>,
     following: Vec<Following<D>>,
-    motion: Option<MovingMesh<D, Free, Stretch>>,
+    motion: Option<MovingMesh<D, Free, SceneMotion<D>>>,
 }
 
 /// No conditions: what a mesh motion wraps in a scene (the scene's own
@@ -128,6 +128,15 @@ impl<const D: usize> SceneConstraints<D> {
     /// Whether nothing is prescribed.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// Position at load factor `lambda` of the mesh node `node` whose
+    /// initial position is `x0` (`x0` itself without a mesh motion).
+    pub fn node_position(&self, node: usize, x0: &SVector<f64, D>, lambda: f64) -> SVector<f64, D> {
+        match &self.motion {
+            Some(m) => m.motion.position(node, x0, lambda),
+            None => *x0,
+        }
     }
 }
 
@@ -295,8 +304,8 @@ pub struct Problem<const D: usize> {
     /// The patch (parent element) of every element of a simplex mesh split
     /// from quadratic parents (for F-patch), `None` otherwise.
     pub patch_of_element: Option<Vec<usize>>,
-    /// Reaction histories: name and the set's mesh nodes (sorted).
-    pub reactions: Vec<(String, Vec<usize>)>,
+    /// Reaction histories.
+    pub reactions: Vec<ReactionOutput<D>>,
     /// Probes: name and the point nearest the location.
     pub probes: Vec<(String, usize)>,
     /// VTU files every this many steps.
@@ -305,6 +314,60 @@ pub struct Problem<const D: usize> {
     pub fields: Vec<Field>,
     /// Write a PNG of the final state.
     pub png: bool,
+}
+
+/// A reaction history of `[[output.reaction]]`: the sum of the reactions
+/// on a node set and, if asked, their moment about a point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReactionOutput<const D: usize> {
+    /// File name stem: `reaction_<name>.csv`.
+    pub name: String,
+    /// The set's mesh nodes (sorted).
+    pub nodes: Vec<usize>,
+    /// The point the moment is taken about.
+    pub about: Option<SVector<f64, D>>,
+}
+
+impl<const D: usize> ReactionOutput<D> {
+    /// The sum of the step's reactions on the set's nodes.
+    pub fn total(&self, report: &mpm_solver::StepReport<D>) -> SVector<f64, D> {
+        report.reaction_on(&self.nodes)
+    }
+
+    /// The moment $\sum_v (\mathbf x_v - \mathbf c)\times\mathbf r_v$ of
+    /// the step's reactions on the set about `about` (`None` without it);
+    /// in 2D only the third component is non-zero. $\mathbf x_v$ is where
+    /// the step's material at the node ends: the node's position in the
+    /// mesh at the start of the step plus its prescribed increment (its
+    /// free components, where the reaction is zero, at their start
+    /// value). With it the moments of all reactions balance, as the
+    /// internal forces of a symmetric stress have no resultant moment
+    /// about any point in the configuration the step's gradients are taken
+    /// in.
+    pub fn moment(
+        &self,
+        problem: &Problem<D>,
+        report: &mpm_solver::StepReport<D>,
+    ) -> Option<[f64; 3]> {
+        let c = self.about?;
+        let lift =
+            |v: &SVector<f64, D>| nalgebra::Vector3::from_fn(|i, _| if i < D { v[i] } else { 0.0 });
+        let m = report
+            .node_reactions
+            .iter()
+            .filter(|(v, _)| self.nodes.binary_search(v).is_ok())
+            .fold(nalgebra::Vector3::zeros(), |m, (v, r)| {
+                let cons = &problem.constraints;
+                let mut x = cons.node_position(*v, &problem.mesh.node_position(*v), report.lambda0);
+                for i in 0..D {
+                    x[i] += cons
+                        .prescribed(*v, i, report.lambda0, report.lambda1)
+                        .unwrap_or(0.0);
+                }
+                m + lift(&(x - c)).cross(&lift(r))
+            });
+        Some([m[0], m[1], m[2]])
+    }
 }
 
 /// Lengths, positivity and finiteness checks with located errors.
@@ -1525,7 +1588,16 @@ impl<const D: usize> Problem<D> {
         let reactions = o
             .reactions
             .iter()
-            .map(|r| Ok((safe(&r.name)?, set_of(&r.set)?.clone())))
+            .map(|r| {
+                Ok(ReactionOutput {
+                    name: safe(&r.name)?,
+                    nodes: set_of(&r.set)?.clone(),
+                    about: match &r.about {
+                        Some(a) => Some(point::<D>(a, "reaction `about`", src)?),
+                        None => None,
+                    },
+                })
+            })
             .collect::<Result<Vec<_>, CasesError>>()?;
         let probes = o
             .probes
@@ -1563,6 +1635,7 @@ impl<const D: usize> Problem<D> {
                 tolerance,
                 max_iterations,
                 predictor: s.predictor,
+                first_tangent: s.first_tangent.into(),
                 ..NewtonOptions::default()
             },
             variant,
@@ -1903,6 +1976,27 @@ fn gradient_of<const D: usize>(
     Ok(nalgebra::SMatrix::<f64, D, D>::from_fn(|i, j| rows[i][j]))
 }
 
+/// The mesh motions a scene can give (`[mesh.motion] kind`): one type, so
+/// that the solvers are compiled once whatever the motion (it is evaluated
+/// once per node and step).
+#[derive(Debug, Clone, PartialEq)]
+pub enum SceneMotion<const D: usize> {
+    /// `stretch`.
+    Stretch(Stretch),
+    /// `rotation`.
+    Rotation(Rotation<D>),
+}
+
+impl<const D: usize> MeshMotion<D> for SceneMotion<D> {
+    #[inline]
+    fn position(&self, node: usize, x0: &SVector<f64, D>, lambda: f64) -> SVector<f64, D> {
+        match self {
+            SceneMotion::Stretch(m) => MeshMotion::<D>::position(m, node, x0, lambda),
+            SceneMotion::Rotation(m) => m.position(node, x0, lambda),
+        }
+    }
+}
+
 /// The mesh motion of `[mesh.motion]`.
 fn motion_of<const D: usize>(
     spec: &super::format::MotionSpec,
@@ -1911,36 +2005,102 @@ fn motion_of<const D: usize>(
     lower: SVector<f64, D>,
     upper: SVector<f64, D>,
     src: &SceneSource,
-) -> Result<MovingMesh<D, Free, Stretch>, CasesError> {
+) -> Result<MovingMesh<D, Free, SceneMotion<D>>, CasesError> {
     let axis_of = |name: &str| AXES.iter().take(D).position(|a| *a == name);
-    let Some(axis) = axis_of(spec.axis.get_ref()) else {
-        return Err(src.at(
-            &spec.axis,
-            format!("`axis` must be one of {}", AXES[..D].join(", ")),
-        ));
+    let axis =
+        match &spec.axis {
+            Some(a) => Some(axis_of(a.get_ref()).ok_or_else(|| {
+                src.at(a, format!("`axis` must be one of {}", AXES[..D].join(", ")))
+            })?),
+            None => None,
+        };
+    let refuse = |present: bool, key: &str, kind: &str| -> Result<(), CasesError> {
+        if present {
+            Err(src.at(
+                &spec.kind,
+                format!("`{key}` does not apply to a {kind} motion"),
+            ))
+        } else {
+            Ok(())
+        }
     };
-    let MotionKind::Stretch = spec.kind.get_ref();
-    let origin = spec.origin.unwrap_or(lower[axis]);
-    let length = match &spec.length {
-        Some(l) => *l.get_ref(),
-        None => upper[axis] - origin,
+    let (motion, default_components) = match spec.kind.get_ref() {
+        MotionKind::Stretch => {
+            refuse(spec.centre.is_some(), "centre", "stretch")?;
+            refuse(spec.angle.is_some(), "angle", "stretch")?;
+            let Some(axis) = axis else {
+                return Err(src.at(&spec.kind, "a stretch needs `axis`"));
+            };
+            let Some(extension) = &spec.extension else {
+                return Err(src.at(&spec.kind, "a stretch needs `extension` (m)"));
+            };
+            let extension = *extension.get_ref();
+            let origin = spec.origin.unwrap_or(lower[axis]);
+            let length = match &spec.length {
+                Some(l) => *l.get_ref(),
+                None => upper[axis] - origin,
+            };
+            if !(length > 0.0 && length.is_finite() && origin.is_finite()) {
+                return Err(src.at(
+                    &spec.kind,
+                    format!("a stretch needs a finite positive length from `origin`, got {length}"),
+                ));
+            }
+            if !extension.is_finite() || length + extension <= 0.0 {
+                return Err(src.at(
+                    spec.extension.as_ref().map_or(&spec.kind, |_| &spec.kind),
+                    format!("`extension` {extension} must be finite and leave a positive length"),
+                ));
+            }
+            let mut components = [false; D];
+            components[axis] = true;
+            (
+                SceneMotion::Stretch(Stretch {
+                    axis,
+                    origin,
+                    length,
+                    extension,
+                }),
+                components,
+            )
+        }
+        MotionKind::Rotation => {
+            refuse(spec.extension.is_some(), "extension", "rotation")?;
+            refuse(spec.length.is_some(), "length", "rotation")?;
+            refuse(spec.origin.is_some(), "origin", "rotation")?;
+            if D == 3 && axis.is_none() {
+                return Err(src.at(&spec.kind, "a rotation in 3D needs `axis` (x, y or z)"));
+            }
+            if let (2, Some(a)) = (D, &spec.axis) {
+                return Err(src.at(
+                    a,
+                    "a rotation in 2D is about the out-of-plane axis: leave out `axis`",
+                ));
+            }
+            let centre = match &spec.centre {
+                None => SVector::<f64, D>::zeros(),
+                Some(c) => {
+                    if c.get_ref().len() != D || c.get_ref().iter().any(|x| !x.is_finite()) {
+                        return Err(src.at(c, format!("`centre` must be {D} finite numbers")));
+                    }
+                    SVector::<f64, D>::from_fn(|i, _| c.get_ref()[i])
+                }
+            };
+            let Some(angle) = &spec.angle else {
+                return Err(src.at(
+                    &spec.kind,
+                    "a rotation needs `angle` (radians at load factor 1)",
+                ));
+            };
+            if !angle.get_ref().is_finite() {
+                return Err(src.at(angle, "`angle` must be finite"));
+            }
+            let rotation =
+                Rotation::about_coordinate_axis(centre, axis.unwrap_or(2), *angle.get_ref())
+                    .ok_or_else(|| src.at(&spec.kind, "a rotation needs 2 or 3 dimensions"))?;
+            (SceneMotion::Rotation(rotation), [true; D])
+        }
     };
-    if !(length > 0.0 && length.is_finite() && origin.is_finite()) {
-        let at = spec.length.as_ref().map_or(&spec.axis, |_| &spec.axis);
-        return Err(src.at(
-            at,
-            format!("a stretch needs a finite positive length from `origin`, got {length}"),
-        ));
-    }
-    if !spec.extension.is_finite() || length + spec.extension <= 0.0 {
-        return Err(src.at(
-            &spec.kind,
-            format!(
-                "`extension` {} must be finite and leave a positive length",
-                spec.extension
-            ),
-        ));
-    }
     let driven = sets.get(spec.driven.get_ref()).ok_or_else(|| {
         src.at(
             &spec.driven,
@@ -1951,10 +2111,10 @@ fn motion_of<const D: usize>(
             ),
         )
     })?;
-    let mut components = [false; D];
-    match &spec.components {
-        None => components[axis] = true,
+    let components = match &spec.components {
+        None => default_components,
         Some(list) => {
+            let mut components = [false; D];
             for name in list.get_ref() {
                 let Some(i) = axis_of(name) else {
                     return Err(src.at(
@@ -1964,13 +2124,8 @@ fn motion_of<const D: usize>(
                 };
                 components[i] = true;
             }
+            components
         }
-    }
-    let motion = Stretch {
-        axis,
-        origin,
-        length,
-        extension: spec.extension,
     };
     Ok(MovingMesh::new(
         Free,

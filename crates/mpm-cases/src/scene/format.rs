@@ -140,6 +140,10 @@ pub enum MotionKind {
     /// Uniform stretch along one axis: $x_a = o + (X_a - o)(L_0 +
     /// \lambda\,\Delta L)/L_0$, the other coordinates fixed.
     Stretch,
+    /// Rigid rotation of the whole mesh about a centre (2D) or an axis
+    /// through a centre (3D) by $\lambda\,\Theta$ (Wang et al. 2021 §5.5:
+    /// "rotate the whole mesh with the vane").
+    Rotation,
 }
 
 /// `[mesh.motion]`: the background mesh follows the load factor, and the
@@ -150,8 +154,10 @@ pub enum MotionKind {
 pub struct MotionSpec {
     /// The motion.
     pub kind: Spanned<MotionKind>,
-    /// `stretch`: the stretched axis (`x`, `y` or `z`).
-    pub axis: Spanned<String>,
+    /// `stretch`: the stretched axis; `rotation` in 3D: the axis of
+    /// rotation (`x`, `y` or `z`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<Spanned<String>>,
     /// `stretch`: coordinate of the plane that stays (default: the mesh's
     /// lower bound along the axis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -161,11 +167,20 @@ pub struct MotionSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub length: Option<Spanned<f64>>,
     /// `stretch`: extension $\Delta L$ at load factor 1 (m).
-    pub extension: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extension: Option<Spanned<f64>>,
+    /// `rotation`: the centre (a point of the axis in 3D; default the
+    /// origin).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub centre: Option<Spanned<Vec<f64>>>,
+    /// `rotation`: the angle $\Theta$ at load factor 1 (radians,
+    /// counter-clockwise about the axis).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle: Option<Spanned<f64>>,
     /// Node set whose nodes move with the mesh.
     pub driven: Spanned<String>,
     /// Components of the driven nodes that are prescribed (default: the
-    /// axis).
+    /// axis for a stretch, every component for a rotation).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub components: Option<Spanned<Vec<String>>>,
 }
@@ -452,6 +467,29 @@ pub struct SolverSpec {
     /// predictor; keeps Newton on the branch of the previous step where
     /// perfectly plastic equilibrium paths bifurcate).
     pub predictor: bool,
+    /// The tangent of a step's first solve when it starts from prescribed
+    /// increments alone ([`mpm_solver::FirstTangent`]).
+    pub first_tangent: FirstTangentSpec,
+}
+
+/// `solver.first_tangent`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum FirstTangentSpec {
+    /// The converged state at the start of the step.
+    #[default]
+    Converged,
+    /// The trial state of the prescribed increments.
+    Trial,
+}
+
+impl From<FirstTangentSpec> for mpm_solver::FirstTangent {
+    fn from(s: FirstTangentSpec) -> Self {
+        match s {
+            FirstTangentSpec::Converged => Self::Converged,
+            FirstTangentSpec::Trial => Self::Trial,
+        }
+    }
 }
 
 impl Default for SolverSpec {
@@ -471,6 +509,7 @@ impl Default for SolverSpec {
             tolerance: Spanned::new(0..0, 1e-9),
             max_iterations: Spanned::new(0..0, newton.max_iterations),
             predictor: newton.predictor,
+            first_tangent: FirstTangentSpec::default(),
         }
     }
 }
@@ -485,6 +524,11 @@ pub struct ReactionSpec {
     pub name: Spanned<String>,
     /// The node set.
     pub set: Spanned<String>,
+    /// Also write the moment of the reactions about this point (2D: a
+    /// scalar about the out-of-plane axis; 3D: a vector); see
+    /// [`crate::scene::build::ReactionOutput::moment`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub about: Option<Spanned<Vec<f64>>>,
 }
 
 /// A displacement history of the material point nearest a location.

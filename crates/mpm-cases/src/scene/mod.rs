@@ -63,7 +63,7 @@ mod program;
 pub mod region;
 mod runner;
 
-pub use build::{Problem, SceneConstraints};
+pub use build::{Problem, ReactionOutput, SceneConstraints, SceneMotion};
 pub use format::Scene;
 pub use program::run_file;
 pub use runner::{RunScene, run};

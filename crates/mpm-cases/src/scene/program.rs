@@ -1,6 +1,5 @@
 //! The `mpm` program's run of a whole-problem scene file.
 
-use nalgebra::SVector;
 use serde_json::{Map, Value, json};
 
 use crate::CasesError;
@@ -101,19 +100,29 @@ where
     let mut last_probes = Map::new();
     let r = crate::scene::run(problem, &control, |s, rep, snap| {
         let io = observer_error;
-        for (name, nodes) in &problem.reactions {
-            let total = rep
-                .node_reactions
-                .iter()
-                .filter(|(v, _)| nodes.binary_search(v).is_ok())
-                .fold(SVector::<f64, D>::zeros(), |t, (_, r)| t + r);
+        for reaction in &problem.reactions {
+            let total = reaction.total(rep);
             let mut row = vec![CsvValue::from(rep.lambda1)];
             row.extend(total.iter().map(|x| CsvValue::from(*x)));
-            let header: Vec<&str> = reaction_header.iter().map(String::as_str).collect();
+            let mut header: Vec<&str> = reaction_header.iter().map(String::as_str).collect();
+            let moment = reaction.moment(problem, rep);
+            if let Some(m) = moment {
+                if D == 2 {
+                    header.push("moment");
+                    row.push(CsvValue::from(m[2]));
+                } else {
+                    header.extend(["moment_x", "moment_y", "moment_z"]);
+                    row.extend(m.iter().map(|x| CsvValue::from(*x)));
+                }
+            }
             obs.writer
-                .case_row(&format!("reaction_{name}.csv"), &header, &row)
+                .case_row(&format!("reaction_{}.csv", reaction.name), &header, &row)
                 .map_err(io)?;
-            last_reactions.insert(name.clone(), json!(total.as_slice()));
+            let mut entry = json!(total.as_slice());
+            if let Some(m) = moment {
+                entry = json!({"force": total.as_slice(), "moment": if D == 2 { json!(m[2]) } else { json!(m) }});
+            }
+            last_reactions.insert(reaction.name.clone(), entry);
         }
         for (name, p) in &problem.probes {
             let u = &snap.displacement[*p][..D];

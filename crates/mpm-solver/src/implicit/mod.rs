@@ -39,7 +39,7 @@ mod stages;
 mod verification;
 
 pub use builder::ImplicitBuilder;
-pub use options::{MAX_BACKTRACKS, NewtonOptions};
+pub use options::{FirstTangent, MAX_BACKTRACKS, NewtonOptions};
 pub use report::{FreeStiffness, StepError, StepReport};
 
 use mpm_constitutive::Response;
@@ -181,7 +181,19 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         lambda1: f64,
     ) -> Result<StepReport<D>, StepError> {
         self.prepare_step(points, lambda0, lambda1)?;
-        self.predict(lambda1 - lambda0);
+        let predicted = self.predict(lambda1 - lambda0);
+        // The first solve linearises about the converged state when the
+        // step starts from prescribed increments alone (FirstTangent).
+        let linearised_start = self.options.first_tangent == FirstTangent::Converged
+            && !predicted
+            && self.it.du.iter().any(|&u| u != 0.0);
+        if linearised_start {
+            self.linearised_start(points)
+                .map_err(|cause| StepError::Retry {
+                    cause,
+                    last_residual: f64::NAN,
+                })?;
+        }
         let o = &self.options;
         let mut monitor = NewtonMonitor::new(o.tolerance, o.divergence_factor, o.max_iterations)
             .with_rounding_floor(o.rounding_floor_factor);
@@ -241,6 +253,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             free_dofs: self.system.n_free,
             factorisation: self.linear.last_factorisation(),
             backtracked,
+            linearised_start,
         })
     }
 

@@ -60,6 +60,32 @@ pub struct NewtonOptions {
     /// 0.9 for F-patch, i.e. 4e-10 and 1.5e-9 against a 1e-9 tolerance).
     /// Zero restores eq. (40) alone.
     pub rounding_floor_factor: f64,
+    /// The tangent of a step's first solve when the step starts from
+    /// prescribed increments alone (no predictor).
+    pub first_tangent: FirstTangent,
+}
+
+/// Which state the first Newton solve of a displacement-driven step
+/// linearises about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FirstTangent {
+    /// The converged state at the start of the step, as a finite-element
+    /// code that imposes the prescribed increments in its first solve
+    /// (e.g. AMPLE): $K_{ff}(0)\Delta\mathbf u_f = \mathbf f^{ext}_f -
+    /// \mathbf f^{int}_f(0) - K_{fp}(0)\Delta\mathbf u_p$
+    /// ([`crate::ImplicitSolver`]'s `linearised_start`), one assembly and
+    /// solve more per step, then Newton from that iterate. Without it,
+    /// Newton starts from the prescribed increments alone, where the layer
+    /// of elements next to the driven nodes carries the whole increment:
+    /// past yield it linearises about that layer's plastic (for perfect
+    /// plasticity, deviatorically singular) tangent, the first correction
+    /// concentrates the increment in it and the step can diverge although
+    /// the equilibrium it seeks is elastic.
+    #[default]
+    Converged,
+    /// The trial state of the prescribed increments (plain Newton from
+    /// that iterate).
+    Trial,
 }
 
 impl Default for NewtonOptions {
@@ -73,6 +99,7 @@ impl Default for NewtonOptions {
             predictor: false,
             max_increment_norm: 10.0,
             rounding_floor_factor: 10.0,
+            first_tangent: FirstTangent::Converged,
         }
     }
 }

@@ -11,12 +11,13 @@ use crate::stages::system::NONE;
 impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// Free dofs start from the previous converged increment scaled to
     /// this step's load increment `dlambda`.
-    pub(super) fn predict(&mut self, dlambda: f64) {
+    /// Whether it set any increment.
+    pub(super) fn predict(&mut self, dlambda: f64) -> bool {
         if !self.options.predictor {
-            return;
+            return false;
         }
         let Some((previous, dlambda_prev)) = &self.previous else {
-            return;
+            return false;
         };
         let scale = dlambda / dlambda_prev;
         let sys = &self.system;
@@ -26,6 +27,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 self.it.du[dof] = scale * previous[mesh_dof];
             }
         }
+        true
     }
 
     /// The secant predictor's memory: the last converged increment per mesh

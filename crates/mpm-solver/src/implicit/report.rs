@@ -48,12 +48,25 @@ pub struct StepReport<const D: usize> {
     /// shortened by backtracking; the iterations after the last of them are
     /// plain Newton steps.
     pub backtracked: Vec<usize>,
+    /// Whether the step began with the solve linearised about the
+    /// converged state ([`crate::FirstTangent::Converged`]): one
+    /// assembly and solve more than `residuals` counts.
+    pub linearised_start: bool,
 }
 
 impl<const D: usize> StepReport<D> {
     /// Number of Newton iterations (linear solves).
     pub fn iterations(&self) -> usize {
         self.residuals.len().saturating_sub(1)
+    }
+
+    /// The sum of the reactions on the mesh nodes `nodes` (sorted
+    /// ascending): a footing's or a base's force.
+    pub fn reaction_on(&self, nodes: &[usize]) -> SVector<f64, D> {
+        self.node_reactions
+            .iter()
+            .filter(|(v, _)| nodes.binary_search(v).is_ok())
+            .fold(SVector::zeros(), |t, (_, r)| t + r)
     }
 }
 

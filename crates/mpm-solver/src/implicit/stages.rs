@@ -9,6 +9,13 @@ use nalgebra::{Matrix3, SVector};
 use rayon::prelude::*;
 
 use super::{ImplicitSolver, MAX_BACKTRACKS};
+
+/// $\epsilon$ of the forward difference in
+/// [`ImplicitSolver::linearised_start`]: small enough that points
+/// elastic at the converged state stay elastic, large enough that rounding
+/// in $\mathbf f^{int}$ (relative $10^{-16}$ of the stresses, against
+/// $\epsilon$ times a step's change) stays far below the tolerance.
+pub const LINEARISED_START_STEP: f64 = 1e-3;
 use crate::boundary::{Constraints, StepView};
 use crate::error::{SolverError, StepFailure};
 use crate::formulation::Formulation;
@@ -320,6 +327,40 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             self.patch_tangents();
         }
         Ok(())
+    }
+
+    /// Stage 3b ([`crate::FirstTangent::Converged`]): the first solve of a
+    /// step that starts from its prescribed increments $\Delta\mathbf u_p$
+    /// alone, linearised about the converged state,
+    /// $K_{ff}(0)\,\Delta\mathbf u_f = \mathbf f^{ext}_f - \mathbf
+    /// f^{int}_f(0) - K_{fp}(0)\,\Delta\mathbf u_p$. $K_{ff}(0)$ is the
+    /// stiffness at zero increment (every point's tangent at $\Delta F = I$
+    /// with its committed state); the coupling $K_{fp}(0)\Delta\mathbf
+    /// u_p$, whose block the free-dof assembly does not hold, is the
+    /// forward difference $[\mathbf f^{int}(\epsilon\Delta\mathbf u_p) -
+    /// \mathbf f^{int}(0)]/\epsilon$ with $\epsilon$ =
+    /// [`LINEARISED_START_STEP`] (exact for a linear response, and the
+    /// directional derivative of the return map where a point is loaded
+    /// plastically from the yield surface). Leaves the increment at
+    /// $(\Delta\mathbf u_f, \Delta\mathbf u_p)$ for Newton's iteration 0.
+    pub(super) fn linearised_start(&mut self, points: &PointsOf<D, P>) -> Result<(), StepFailure> {
+        let prescribed = std::mem::take(&mut self.it.du);
+        self.it.du = vec![0.0; prescribed.len()];
+        self.update_material_points(points)?;
+        self.assemble_internal_force();
+        let f0 = self.it.f_int.clone();
+        self.update_tangents(points)?;
+        self.assemble_stiffness();
+        let eps = LINEARISED_START_STEP;
+        self.it.du = prescribed.iter().map(|u| eps * u).collect();
+        self.update_material_points(points)?;
+        self.assemble_internal_force();
+        for (f, f0) in self.it.f_int.iter_mut().zip(&f0) {
+            *f = f0 + (*f - f0) / eps;
+        }
+        self.it.du = prescribed;
+        self.solve()
+            .map_err(|source| StepFailure::LinearSolve { source })
     }
 
     /// The coupled part of the tangent ([`crate::stages::patch`]): the
