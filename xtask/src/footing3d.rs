@@ -10,6 +10,7 @@ use anyhow::{Context, Result};
 use mpm_cases::run::{RunControl, RunOutput};
 use mpm_cases::scene::Problem;
 
+use crate::machine::{measured, print_run};
 use crate::markdown::Table;
 use crate::plot::{Axis, Figure, Line, Marker, PALETTE, Series};
 
@@ -40,21 +41,6 @@ struct Curve {
     seconds: f64,
     peak_mb: Option<f64>,
     failure: Option<String>,
-}
-
-/// Resets the process's peak resident memory (Linux: `5` to
-/// `/proc/self/clear_refs`), so that [`peak_mb`] measures what follows.
-pub(crate) fn reset_peak() {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
-/// The peak resident memory since [`reset_peak`] (`VmHWM`), in MB, where
-/// the system reports it.
-pub(crate) fn peak_mb() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb / 1024.0)
 }
 
 fn run(full: bool, fpatch: bool) -> Result<Curve> {
@@ -91,9 +77,7 @@ fn run(full: bool, fpatch: bool) -> Result<Curve> {
         peak_mb: None,
         failure: None,
     };
-    reset_peak();
-    let started = std::time::Instant::now();
-    let result: Result<RunOutput<3>, _> =
+    let (result, seconds, peak): (Result<RunOutput<3>, _>, _, _) = measured(|| {
         mpm_cases::scene::run(&problem, &RunControl::default(), |_, report, _| {
             let force = footing.total(report)[2];
             curve.points.push((
@@ -103,21 +87,18 @@ fn run(full: bool, fpatch: bool) -> Result<Curve> {
             curve.iterations += report.residuals.len();
             curve.max_iterations = curve.max_iterations.max(report.residuals.len());
             Ok(())
-        });
-    curve.seconds = started.elapsed().as_secs_f64();
-    curve.peak_mb = peak_mb();
+        })
+    });
+    (curve.seconds, curve.peak_mb) = (seconds, peak);
     if let Err(e) = result {
         curve.failure = Some(e.to_string());
     }
-    println!(
-        "footing 3D, {label}: {} steps, {} iterations, {:.1} s{}",
+    print_run(
+        &format!("footing 3D, {label}"),
         curve.points.len() - 1,
         curve.iterations,
         curve.seconds,
-        curve
-            .failure
-            .as_ref()
-            .map_or(String::new(), |f| format!(", failed: {f}"))
+        curve.failure.as_deref(),
     );
     Ok(curve)
 }

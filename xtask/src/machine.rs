@@ -56,6 +56,38 @@ pub fn load_average() -> Option<f64> {
         .ok()
 }
 
+/// Resets the process's peak resident memory (Linux: `5` to
+/// `/proc/self/clear_refs`), so that [`peak_mb`] measures what follows.
+pub fn reset_peak() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// The peak resident memory since [`reset_peak`] (`VmHWM`), in MB, where
+/// the system reports it.
+pub fn peak_mb() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+/// Runs `f`, returning its result, its wall time in seconds and the peak
+/// resident memory it reached in MB (where the system reports it).
+pub fn measured<T>(f: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
+    reset_peak();
+    let started = std::time::Instant::now();
+    let result = f();
+    (result, started.elapsed().as_secs_f64(), peak_mb())
+}
+
+/// One line on the terminal for a finished (or failed) run.
+pub fn print_run(what: &str, steps: usize, iterations: usize, seconds: f64, failure: Option<&str>) {
+    println!(
+        "{what}: {steps} steps, {iterations} iterations, {seconds:.1} s{}",
+        failure.map_or(String::new(), |f| format!(", failed: {f}"))
+    );
+}
+
 #[cfg(test)]
 mod tests {
     use super::civil_from_days;

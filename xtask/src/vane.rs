@@ -11,7 +11,7 @@ use anyhow::{Context, Result};
 use mpm_cases::run::{RunControl, RunOutput};
 use mpm_cases::scene::Problem;
 
-use crate::footing3d::{peak_mb, reset_peak};
+use crate::machine::{measured, print_run};
 use crate::markdown::Table;
 use crate::plot::{Axis, Figure, Line, Marker, PALETTE, Series};
 
@@ -87,32 +87,26 @@ fn run(mesh: &str, fpatch: bool, keast: bool) -> Result<Curve> {
         peak_mb: None,
         failure: None,
     };
-    reset_peak();
-    let started = std::time::Instant::now();
-    let result: Result<RunOutput<3>, _> =
+    let (result, seconds, peak): (Result<RunOutput<3>, _>, _, _) = measured(|| {
         mpm_cases::scene::run(&problem, &RunControl::default(), |_, report, _| {
             let m = vane.moment(&problem, report).map_or(f64::NAN, |m| m[2]);
             curve.torque.push((1e3 * report.lambda1 * ROTATION, m));
             curve.iterations += report.iterations();
             curve.max_iterations = curve.max_iterations.max(report.iterations());
             Ok(())
-        });
-    curve.seconds = started.elapsed().as_secs_f64();
-    curve.peak_mb = peak_mb();
+        })
+    });
+    (curve.seconds, curve.peak_mb) = (seconds, peak);
     match result {
         Ok(out) => curve.cuts = out.summary.cut_steps,
         Err(e) => curve.failure = Some(e.to_string()),
     }
-    println!(
-        "vane slice, {}: {} steps, {} iterations, {:.1} s{}",
-        curve.label,
+    print_run(
+        &format!("vane slice, {}", curve.label),
         curve.torque.len() - 1,
         curve.iterations,
         curve.seconds,
-        curve
-            .failure
-            .as_ref()
-            .map_or(String::new(), |f| format!(", failed: {f}"))
+        curve.failure.as_deref(),
     );
     Ok(curve)
 }

@@ -350,6 +350,7 @@ impl<const D: usize> ReactionOutput<D> {
         report: &mpm_solver::StepReport<D>,
     ) -> Option<[f64; 3]> {
         let c = self.about?;
+        let cons = &problem.constraints;
         let lift =
             |v: &SVector<f64, D>| nalgebra::Vector3::from_fn(|i, _| if i < D { v[i] } else { 0.0 });
         let m = report
@@ -357,7 +358,6 @@ impl<const D: usize> ReactionOutput<D> {
             .iter()
             .filter(|(v, _)| self.nodes.binary_search(v).is_ok())
             .fold(nalgebra::Vector3::zeros(), |m, (v, r)| {
-                let cons = &problem.constraints;
                 let mut x = cons.node_position(*v, &problem.mesh.node_position(*v), report.lambda0);
                 for i in 0..D {
                     x[i] += cons
@@ -2031,24 +2031,27 @@ fn motion_of<const D: usize>(
             let Some(axis) = axis else {
                 return Err(src.at(&spec.kind, "a stretch needs `axis`"));
             };
-            let Some(extension) = &spec.extension else {
+            let Some(extension_at) = &spec.extension else {
                 return Err(src.at(&spec.kind, "a stretch needs `extension` (m)"));
             };
-            let extension = *extension.get_ref();
+            let extension = *extension_at.get_ref();
             let origin = spec.origin.unwrap_or(lower[axis]);
             let length = match &spec.length {
                 Some(l) => *l.get_ref(),
                 None => upper[axis] - origin,
             };
             if !(length > 0.0 && length.is_finite() && origin.is_finite()) {
-                return Err(src.at(
-                    &spec.kind,
-                    format!("a stretch needs a finite positive length from `origin`, got {length}"),
+                let at = spec.length.as_ref().map_or(spec.kind.span(), Spanned::span);
+                return Err(src.error(
+                    Some(at),
+                    &format!(
+                        "a stretch needs a finite positive length from `origin`, got {length}"
+                    ),
                 ));
             }
             if !extension.is_finite() || length + extension <= 0.0 {
                 return Err(src.at(
-                    spec.extension.as_ref().map_or(&spec.kind, |_| &spec.kind),
+                    extension_at,
                     format!("`extension` {extension} must be finite and leave a positive length"),
                 ));
             }
@@ -2079,12 +2082,7 @@ fn motion_of<const D: usize>(
             }
             let centre = match &spec.centre {
                 None => SVector::<f64, D>::zeros(),
-                Some(c) => {
-                    if c.get_ref().len() != D || c.get_ref().iter().any(|x| !x.is_finite()) {
-                        return Err(src.at(c, format!("`centre` must be {D} finite numbers")));
-                    }
-                    SVector::<f64, D>::from_fn(|i, _| c.get_ref()[i])
-                }
+                Some(c) => point::<D>(c, "rotation `centre`", src)?,
             };
             let Some(angle) = &spec.angle else {
                 return Err(src.at(

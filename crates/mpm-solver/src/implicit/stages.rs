@@ -9,13 +9,6 @@ use nalgebra::{Matrix3, SVector};
 use rayon::prelude::*;
 
 use super::{ImplicitSolver, MAX_BACKTRACKS};
-
-/// $\epsilon$ of the forward difference in
-/// [`ImplicitSolver::linearised_start`]: small enough that points
-/// elastic at the converged state stay elastic, large enough that rounding
-/// in $\mathbf f^{int}$ (relative $10^{-16}$ of the stresses, against
-/// $\epsilon$ times a step's change) stays far below the tolerance.
-pub const LINEARISED_START_STEP: f64 = 1e-3;
 use crate::boundary::{Constraints, StepView};
 use crate::error::{SolverError, StepFailure};
 use crate::formulation::Formulation;
@@ -25,6 +18,13 @@ use crate::mesh::NodalMesh;
 use crate::parts::{PointsOf, SolverParts};
 use crate::stages::system::NONE;
 use crate::stages::{basis, gather, update as grid_to_point};
+
+/// $\epsilon$ of the forward difference in
+/// [`ImplicitSolver::linearised_start`]: small enough that points
+/// elastic at the converged state stay elastic, large enough that rounding
+/// in $\mathbf f^{int}$ (relative $10^{-16}$ of the stresses, against
+/// $\epsilon$ times a step's change) stays far below the tolerance.
+const LINEARISED_START_STEP: f64 = 1e-3;
 
 /// The material point a failure names, if any.
 fn failed_point(f: &StepFailure) -> Option<usize> {
@@ -344,21 +344,25 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// plastically from the yield surface). Leaves the increment at
     /// $(\Delta\mathbf u_f, \Delta\mathbf u_p)$ for Newton's iteration 0.
     pub(super) fn linearised_start(&mut self, points: &PointsOf<D, P>) -> Result<(), StepFailure> {
-        let prescribed = std::mem::take(&mut self.it.du);
-        self.it.du = vec![0.0; prescribed.len()];
+        // Once per step: the prescribed increments and f_int(0) are kept
+        // aside while the increment goes to 0 and to ε Δu_p.
+        let prescribed = self.it.du.clone();
+        self.it.du.fill(0.0);
         self.update_material_points(points)?;
         self.assemble_internal_force();
         let f0 = self.it.f_int.clone();
         self.update_tangents(points)?;
         self.assemble_stiffness();
         let eps = LINEARISED_START_STEP;
-        self.it.du = prescribed.iter().map(|u| eps * u).collect();
+        for (u, p) in self.it.du.iter_mut().zip(&prescribed) {
+            *u = eps * p;
+        }
         self.update_material_points(points)?;
         self.assemble_internal_force();
         for (f, f0) in self.it.f_int.iter_mut().zip(&f0) {
             *f = f0 + (*f - f0) / eps;
         }
-        self.it.du = prescribed;
+        self.it.du.copy_from_slice(&prescribed);
         self.solve()
             .map_err(|source| StepFailure::LinearSolve { source })
     }
