@@ -250,7 +250,8 @@ fn elastica_deviation(p: &CantileverParams, tip: &[(f64, f64, f64)]) -> (f64, f6
 /// §7.3 with GIMP (eq. 37, 6² points, Fig. 15) and CPDI2 (4² points; the
 /// paper's Fig. 17 uses 3², but the load is split between the two points
 /// beside the neutral axis, which needs an even count): all 50 steps
-/// converge, UL = PC, and the tip at full load is within 0.015 l0 of the
+/// converge, UL = PC (to 1e-9 at a Newton tolerance of 1e-11), and the tip
+/// at full load is within 0.015 l0 of the
 /// elastica (α = P l0²/EI = 10). Along the path, h = 0.5 m (two cells
 /// through the depth) is too stiff in early bending and the point load
 /// makes it overshoot late (the paper's Fig. 16); refining to h = 0.25 m
@@ -259,8 +260,13 @@ fn elastica_deviation(p: &CantileverParams, tip: &[(f64, f64, f64)]) -> (f64, f6
 fn cantilever_with_gimp_and_cpdi2_follows_the_elastica() {
     let mut coarse = 0.0;
     for (v, ppc) in [(gimp(DomainUpdateKind::CornerMidpoint), 6), (cpdi2(), 4)] {
+        // UL and PC reach the same equilibrium, so they differ by what
+        // the Newton tolerance leaves: measured 1.5e-8 at the default 1e-9
+        // (1.0e-9 before the 2026-12-03 rounding changes of the tangent
+        // products), 3.2e-10 at 1e-11. Compared at 1e-11, to 1e-9.
         let p = CantileverParams {
             points_per_cell: ppc,
+            tolerance: 1e-11,
             ..CantileverParams::default()
         };
         let go = |f: FormulationKind| {
@@ -288,7 +294,7 @@ fn cantilever_with_gimp_and_cpdi2_follows_the_elastica() {
             p.h
         );
         assert!(end.0 <= 0.015 && end.1 <= 0.015, "{end:?}");
-        assert!(worst_ul <= 1e-8);
+        assert!(worst_ul <= 1e-9, "{worst_ul:e}");
         if v.basis == BasisKind::Gimp {
             coarse = path.0.max(path.1);
         }

@@ -56,7 +56,18 @@ impl SymSpectral {
         if sym[(0, 2)] == 0.0 && sym[(1, 2)] == 0.0 {
             return Ok(Self::plane(&sym));
         }
-        let eig = SymmetricEigen::try_new(sym, f64::EPSILON, EIGEN_MAX_ITERATIONS)
+        Self::iterative(&sym)
+    }
+
+    /// nalgebra's Householder + implicit QR solver. A closed-form solver
+    /// (Cardano roots, a cross-product eigenvector, the exact 2×2 problem
+    /// for the other pair) was twice as fast and matched this one to
+    /// rounding on 2000 test tensors, but made the F-patch footing of
+    /// Wang 2021 §5.1 (ν = 0.48) stall above its rounding floor and cut 7
+    /// steps where this solver cuts none; it is not used until that is
+    /// understood (`docs/src/benchmarks/solver.md`).
+    fn iterative(sym: &Matrix3<f64>) -> Result<Self> {
+        let eig = SymmetricEigen::try_new(*sym, f64::EPSILON, EIGEN_MAX_ITERATIONS)
             .ok_or(ConstitutiveError::EigenDecomposition)?;
         Ok(Self {
             values: eig.eigenvalues,
@@ -151,20 +162,41 @@ impl SymSpectral {
     /// The derivative of an isotropic tensor function given the divided
     /// difference `theta(λa, λb)`, which must return $f'(\lambda)$ when its
     /// arguments are equal and be symmetric in its arguments.
+    ///
+    /// The six rank-one terms are summed in the six-component (Voigt)
+    /// storage of symmetric tensors, upper triangle only, and expanded to
+    /// the $9\times9$ storage once: 126 multiply-adds against 486.
     pub fn derivative(&self, theta: impl Fn(f64, f64) -> f64) -> Tensor4 {
+        // Voigt position of component (i, j) and the (i, j) of each.
+        const VOIGT: [[usize; 3]; 3] = [[0, 3, 4], [3, 1, 5], [4, 5, 2]];
+        const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
         let lam = &self.values;
-        let mut out = Tensor4::zeros();
-        for a in 0..3 {
-            let pa = self.projection(a);
-            out += theta(lam[a], lam[a]) * pa * pa.transpose();
-            for b in (a + 1)..3 {
-                let na = self.vectors.column(a);
-                let nb = self.vectors.column(b);
-                let s = to_vec9(&(0.5 * (na * nb.transpose() + nb * na.transpose())));
-                out += 2.0 * theta(lam[a], lam[b]) * s * s.transpose();
+        let n = &self.vectors;
+        let mut m = [[0.0f64; 6]; 6];
+        let mut add = |w: f64, u: [f64; 6]| {
+            for a in 0..6 {
+                let wa = w * u[a];
+                for b in a..6 {
+                    m[a][b] += wa * u[b];
+                }
             }
+        };
+        for a in 0..3 {
+            add(
+                theta(lam[a], lam[a]),
+                PAIRS.map(|(i, j)| n[(i, a)] * n[(j, a)]),
+            );
         }
-        out
+        for (a, b) in [(0, 1), (0, 2), (1, 2)] {
+            add(
+                2.0 * theta(lam[a], lam[b]),
+                PAIRS.map(|(i, j)| 0.5 * (n[(i, a)] * n[(j, b)] + n[(i, b)] * n[(j, a)])),
+            );
+        }
+        Tensor4::from_fn(|r, c| {
+            let (a, b) = (VOIGT[r / 3][r % 3], VOIGT[c / 3][c % 3]);
+            if a <= b { m[a][b] } else { m[b][a] }
+        })
     }
 
     fn require_positive(&self) -> Result<()> {

@@ -177,7 +177,8 @@ pub fn stiffness<const D: usize>(
 /// h_{vp,i}\,(\mathbf G_{wP} - \mathbf g_{wp})_k$ over the points $p$ of
 /// every patch $P$ whose node union holds $w$ ([`PatchSystem`]; the
 /// pattern must be the patch pattern of
-/// [`StepSystem::build_patch_neighbours`]). One block column per task,
+/// [`StepSystem::build_patch_neighbours`], each entry placed through
+/// [`PatchSystem::place`]). One block column per task,
 /// patches and points ascending, so the sums do not depend on the thread
 /// count.
 pub fn patch_coupling<const D: usize>(
@@ -186,16 +187,18 @@ pub fn patch_coupling<const D: usize>(
     values: &mut [f64],
 ) {
     let block = |w: usize, vals: &mut [f64]| {
-        let nbs = &sys.nb[sys.nb_ptr[w]..sys.nb_ptr[w + 1]];
         let map = &sys.block_map[sys.nb_ptr[w] * D * D..sys.nb_ptr[w + 1] * D * D];
         for &(k, u) in &patches.node_patches[patches.node_ptr[w]..patches.node_ptr[w + 1]] {
-            for &p in patches.members_of(k as usize) {
+            let k = k as usize;
+            let len = patches.union_ptr[k + 1] - patches.union_ptr[k];
+            let start = patches.place_ptr[k] + u as usize * len;
+            // Neighbour position of every union node in column w's list.
+            let place = &patches.place[start..start + len];
+            for &p in patches.members_of(k) {
                 let p = p as usize;
                 let c = patches.column(sys, p, u);
                 for s in sys.slots(p) {
-                    let Ok(pos) = nbs.binary_search(&sys.nodes[s]) else {
-                        continue;
-                    };
+                    let pos = place[patches.local[s] as usize] as usize;
                     let rows = &map[pos * D * D..(pos + 1) * D * D];
                     let h = &patches.h[s];
                     for i in 0..D {

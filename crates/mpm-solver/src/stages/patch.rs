@@ -70,6 +70,13 @@ pub struct PatchSystem<const D: usize> {
     pub patch_grad: Vec<SVector<f64, D>>,
     /// Per slot, $\mathbf h_{vp}$.
     pub h: Vec<SVector<f64, D>>,
+    /// Per patch, a $|U|\times|U|$ table over its node union $U$: entry
+    /// $(u, t)$ is the position of $U_t$ in the neighbour list of $U_u$
+    /// ([`StepSystem::nb`]), so the coupling scatter places an entry
+    /// without a search ([`Self::build_placement`]).
+    pub place: Vec<u32>,
+    /// Start of each patch's table in `place`.
+    pub place_ptr: Vec<usize>,
 }
 
 /// A point whose motion inverts it ($\det\Delta F \le 0$ or not finite).
@@ -197,6 +204,28 @@ impl<const D: usize> PatchSystem<D> {
         self.patch_grad.resize(self.union.len(), SVector::zeros());
     }
 
+    /// The placement table [`Self::place`], once per step after the
+    /// patch neighbour lists ([`StepSystem::build_patch_neighbours`]).
+    /// Every pair of a union is a neighbour pair by construction.
+    pub fn build_placement(&mut self, sys: &StepSystem<D>) {
+        self.place.clear();
+        self.place_ptr.clear();
+        self.place_ptr.push(0);
+        for k in 0..self.patch_count() {
+            let union = &self.union[self.union_ptr[k]..self.union_ptr[k + 1]];
+            for &w in union {
+                let w = w as usize;
+                let nbs = &sys.nb[sys.nb_ptr[w]..sys.nb_ptr[w + 1]];
+                self.place.extend(
+                    union
+                        .iter()
+                        .map(|v| nbs.binary_search(v).unwrap_or_default() as u32),
+                );
+            }
+            self.place_ptr.push(self.place.len());
+        }
+    }
+
     /// The patch averages of the iterate whose point increments are
     /// `increments` (the motion's $\Delta F_q$): $J_q$, $\Delta\bar J_P$,
     /// $\alpha_p$ and $\beta_q$.
@@ -225,7 +254,14 @@ impl<const D: usize> PatchSystem<D> {
             for &q in &self.members[self.member_ptr[k]..self.member_ptr[k + 1]] {
                 let q = q as usize;
                 self.beta[q] = weight[q] * self.det[q] / wj;
-                self.alpha[q] = (self.det_bar[k] / self.det[q]).powf(1.0 / D as f64);
+                let ratio = self.det_bar[k] / self.det[q];
+                // The D-th root; cbrt and sqrt are exact to rounding and
+                // cheaper than powf.
+                self.alpha[q] = match D {
+                    3 => ratio.cbrt(),
+                    2 => ratio.sqrt(),
+                    _ => ratio.powf(1.0 / D as f64),
+                };
             }
         }
         Ok(())
