@@ -131,13 +131,27 @@ pub struct Summary<P: Serialize> {
     pub parameters: P,
 }
 
-/// Columns of `steps.csv`: reactions per component of the dimension, and
-/// the iteration-0 out-of-balance force as the Coombs et al. (2020) tables
-/// print it (`StepReport::initial_unbalance`).
+/// Columns of `steps.csv`: reactions per component of the dimension, the
+/// iteration-0 out-of-balance force as the Coombs et al. (2020) tables
+/// print it (`StepReport::initial_unbalance`), the iterative linear
+/// solver's iterations and the wall-clock seconds of the step and of each
+/// stage (`StepReport::times`).
 fn step_columns(dim: usize) -> Vec<&'static str> {
     let mut columns = vec!["step", "load_factor", "iterations"];
     columns.extend(["reaction_x", "reaction_y", "reaction_z"].iter().take(dim));
     columns.extend(["active_nodes", "free_dofs", "initial_unbalance"]);
+    columns.extend([
+        "linear_iterations",
+        "seconds",
+        "seconds_basis",
+        "seconds_system",
+        "seconds_material",
+        "seconds_force",
+        "seconds_tangent",
+        "seconds_stiffness",
+        "seconds_solve",
+        "seconds_commit",
+    ]);
     columns
 }
 
@@ -248,6 +262,22 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
                 .initial_unbalance
                 .map_or(CsvValue::Str("".into()), CsvValue::from),
         ]);
+        let t = &report.times;
+        row.push(CsvValue::from(report.linear_iterations));
+        row.extend(
+            [
+                t.total(),
+                t.basis,
+                t.system,
+                t.material,
+                t.force,
+                t.tangent,
+                t.stiffness,
+                t.solve,
+                t.commit,
+            ]
+            .map(CsvValue::from),
+        );
         self.steps.push_row(&row)?;
         self.steps.write(&self.dir.join("steps.csv"))?;
         for (k, r) in report.residuals.iter().enumerate() {

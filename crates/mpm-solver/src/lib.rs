@@ -90,10 +90,14 @@ pub use error::{
 };
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
 pub use implicit::{
-    FirstTangent, FreeStiffness, ImplicitBuilder, ImplicitSolver, NewtonOptions, StepError,
-    StepReport,
+    FirstTangent, FreeStiffness, ImplicitBuilder, ImplicitSolver, NewtonOptions, StageTimes,
+    StepError, StepReport,
 };
-pub use linear::{Factorisation, FaerDirect, LinearSolveError, LinearSolver};
+pub use linear::{
+    AutoLinear, DEFAULT_MAX_DIRECT_DOFS_2D, DEFAULT_MAX_DIRECT_DOFS_3D, Factorisation, FaerDirect,
+    FaerIterative, IterativeOptions, LinearChoice, LinearSolveError, LinearSolver,
+    MAX_FALLBACK_DOFS,
+};
 pub use locking::{FBar, FPatch, LockingTreatment, NoLocking, PatchAssignment, PatchInput};
 pub use mesh::{MovableMesh, NodalMesh};
 pub use moving_mesh::{MeshMotion, MovingMesh, Rotation, Stretch, Translation};

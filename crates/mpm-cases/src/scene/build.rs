@@ -21,7 +21,7 @@ use crate::scene_file::SceneSource;
 use crate::variant::Variant;
 
 use super::format::{
-    BoundaryKind, Field, LoadKind, MeshKind, MotionKind, Placement, RegionSpec, Scene,
+    BoundaryKind, Field, LinearKind, LoadKind, MeshKind, MotionKind, Placement, RegionSpec, Scene,
 };
 use super::region::{Region, point};
 
@@ -1565,6 +1565,43 @@ impl<const D: usize> Problem<D> {
         }
         let tolerance = check.positive(&s.tolerance, "solver `tolerance`")?;
         let max_iterations = check.at_least(&s.max_iterations, 1, "solver `max_iterations`")?;
+        let linear = {
+            let mut iterative = mpm_solver::IterativeOptions::default();
+            if let Some(t) = &s.linear_tolerance {
+                let t = check.positive(t, "solver `linear_tolerance`")?;
+                if t >= 1.0 {
+                    return Err(src.at(
+                        s.linear_tolerance.as_ref().map_or(&s.tolerance, |t| t),
+                        "solver `linear_tolerance` must be below 1 (a relative residual)",
+                    ));
+                }
+                iterative.rel_tolerance = t;
+            }
+            match s.linear {
+                LinearKind::Direct => mpm_solver::LinearChoice::Direct,
+                LinearKind::Iterative => mpm_solver::LinearChoice::Iterative(iterative),
+                LinearKind::Auto => mpm_solver::LinearChoice::Auto {
+                    max_direct_dofs: s.max_direct_dofs.as_ref().map(|m| *m.get_ref()),
+                    iterative,
+                },
+            }
+        };
+        if let Some(t) = &s.linear_tolerance
+            && s.linear == LinearKind::Direct
+        {
+            return Err(src.at(
+                t,
+                "solver `linear_tolerance` applies to the iterative solver (`linear = \"iterative\"` or `\"auto\"`) only",
+            ));
+        }
+        if let Some(m) = &s.max_direct_dofs
+            && s.linear != LinearKind::Auto
+        {
+            return Err(src.at(
+                m,
+                "solver `max_direct_dofs` applies to `linear = \"auto\"` only",
+            ));
+        }
 
         // Outputs.
         let o = &scene.output;
@@ -1636,6 +1673,7 @@ impl<const D: usize> Problem<D> {
                 max_iterations,
                 predictor: s.predictor,
                 first_tangent: s.first_tangent.into(),
+                linear,
                 ..NewtonOptions::default()
             },
             variant,

@@ -470,6 +470,29 @@ pub struct SolverSpec {
     /// The tangent of a step's first solve when it starts from prescribed
     /// increments alone ([`mpm_solver::FirstTangent`]).
     pub first_tangent: FirstTangentSpec,
+    /// The linear solver of each Newton iteration.
+    pub linear: LinearKind,
+    /// Relative tolerance of the iterative linear solver (default 1e-12).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub linear_tolerance: Option<Spanned<f64>>,
+    /// With `linear = "auto"`: the largest number of free dofs solved
+    /// directly (default [`mpm_solver::DEFAULT_MAX_DIRECT_DOFS_3D`] in 3D,
+    /// [`mpm_solver::DEFAULT_MAX_DIRECT_DOFS_2D`] in 2D).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_direct_dofs: Option<Spanned<usize>>,
+}
+
+/// `solver.linear`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum LinearKind {
+    /// Direct up to `max_direct_dofs` free dofs, iterative beyond.
+    #[default]
+    Auto,
+    /// Sparse Cholesky with an LU fallback (faer).
+    Direct,
+    /// ILU(0)-preconditioned BiCGSTAB (faer, faer-precond).
+    Iterative,
 }
 
 /// `solver.first_tangent`.
@@ -510,6 +533,9 @@ impl Default for SolverSpec {
             max_iterations: Spanned::new(0..0, newton.max_iterations),
             predictor: newton.predictor,
             first_tangent: FirstTangentSpec::default(),
+            linear: LinearKind::default(),
+            linear_tolerance: None,
+            max_direct_dofs: None,
         }
     }
 }

@@ -40,14 +40,20 @@ mod verification;
 
 pub use builder::ImplicitBuilder;
 pub use options::{FirstTangent, MAX_BACKTRACKS, NewtonOptions};
-pub use report::{FreeStiffness, StepError, StepReport};
+pub use report::{FreeStiffness, StageTimes, StepError, StepReport};
 
 use mpm_constitutive::Response;
 use mpm_constitutive::tensor::Tensor4;
 use nalgebra::{Matrix3, SVector};
 
 use crate::error::StepFailure;
-use crate::linear::{FaerDirect, LinearSolver};
+use crate::linear::LinearSolver;
+use std::time::Instant;
+
+/// Seconds since `clock`.
+fn lap(clock: Instant) -> f64 {
+    clock.elapsed().as_secs_f64()
+}
 use crate::parts::{PointsOf, SolverParts};
 use crate::stages::convergence::{self, NewtonMonitor, Verdict};
 use crate::stages::patch::PatchSystem;
@@ -128,7 +134,7 @@ pub struct ImplicitSolver<const D: usize, P: SolverParts<D>> {
 
 impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// Composes a solver with the default formulation value of
-    /// `P::Formulation` and the faer direct linear solver; see
+    /// `P::Formulation` and the linear solver of `options.linear`; see
     /// [`ImplicitBuilder`] to choose them as values and let the types be
     /// inferred.
     pub fn new(
@@ -149,7 +155,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             updater,
             constraints,
             options,
-            linear: Box::new(FaerDirect::default()),
+            linear: options.linear.build(D),
             analysed: false,
             system: StepSystem::default(),
             patches: PatchSystem::default(),
@@ -159,8 +165,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         }
     }
 
-    /// Replaces the linear solver (the default is [`FaerDirect`] with
-    /// sequential factorisation).
+    /// Replaces the linear solver (the default is the one
+    /// `options.linear` describes: [`crate::LinearChoice`]).
     pub fn set_linear_solver(&mut self, linear: Box<dyn LinearSolver>) {
         self.linear = linear;
         self.analysed = false;
@@ -180,7 +186,17 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         lambda0: f64,
         lambda1: f64,
     ) -> Result<StepReport<D>, StepError> {
-        self.prepare_step(points, lambda0, lambda1)?;
+        let mut times = StageTimes::default();
+        let clock = Instant::now();
+        self.move_mesh(lambda0)?;
+        self.evaluate_basis(points)?;
+        times.basis = lap(clock);
+        let clock = Instant::now();
+        self.begin_constraints(points);
+        self.build_system(points, lambda0, lambda1)?;
+        self.assemble_external_force(points, lambda1);
+        times.system = lap(clock);
+        let mut linear_iterations = 0;
         let predicted = self.predict(lambda1 - lambda0);
         // The first solve linearises about the converged state when the
         // step starts from prescribed increments alone (FirstTangent).
@@ -188,11 +204,14 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             && !predicted
             && self.it.du.iter().any(|&u| u != 0.0);
         if linearised_start {
+            let clock = Instant::now();
             self.linearised_start(points)
                 .map_err(|cause| StepError::Retry {
                     cause,
                     last_residual: f64::NAN,
                 })?;
+            times.solve += lap(clock);
+            linear_iterations += self.linear.last_iterations();
         }
         let o = &self.options;
         let mut monitor = NewtonMonitor::new(o.tolerance, o.divergence_factor, o.max_iterations)
@@ -205,12 +224,16 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         };
         loop {
             let iteration = monitor.iteration();
+            let clock = Instant::now();
             match self.update_material_points_backtracking(points, iteration > 0) {
                 Ok(true) => backtracked.push(iteration),
                 Ok(false) => {}
                 Err(cause) => return Err(retry(cause, &monitor)),
             }
+            times.material += lap(clock);
+            let clock = Instant::now();
             self.assemble_internal_force();
+            times.force += lap(clock);
             if iteration == 0 {
                 initial_unbalance = convergence::unbalance_all_dofs(&self.it.f_int, &self.it.f_ext);
             }
@@ -220,6 +243,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 Verdict::Failed(cause) => return Err(retry(cause, &monitor)),
                 Verdict::Continue => {}
             }
+            let clock = Instant::now();
             self.update_tangents(points)
                 .map_err(|cause| retry(cause, &monitor))?;
             if iteration == 0 {
@@ -229,10 +253,17 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                     &self.it.tangent_w,
                 ));
             }
+            times.tangent += lap(clock);
+            let clock = Instant::now();
             self.assemble_stiffness();
+            times.stiffness += lap(clock);
+            let clock = Instant::now();
             self.solve()
                 .map_err(|source| retry(StepFailure::LinearSolve { source }, &monitor))?;
+            times.solve += lap(clock);
+            linear_iterations += self.linear.last_iterations();
         }
+        let clock = Instant::now();
         let reaction = convergence::reaction(&self.system, &self.it.f_int, &self.it.f_ext);
         let node_reactions =
             convergence::node_reactions(&self.system, &self.it.f_int, &self.it.f_ext);
@@ -240,6 +271,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         // The mesh follows to the end of the step, with the points.
         self.move_mesh(lambda1)?;
         self.remember_increment(lambda1 - lambda0);
+        times.commit = lap(clock);
         Ok(StepReport {
             lambda0,
             lambda1,
@@ -254,6 +286,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             factorisation: self.linear.last_factorisation(),
             backtracked,
             linearised_start,
+            times,
+            linear_iterations,
         })
     }
 

@@ -63,6 +63,8 @@ pub struct NewtonOptions {
     /// The tangent of a step's first solve when the step starts from
     /// prescribed increments alone (no predictor).
     pub first_tangent: FirstTangent,
+    /// The linear solver [`crate::ImplicitSolver::new`] builds.
+    pub linear: crate::linear::LinearChoice,
 }
 
 /// Which state the first Newton solve of a displacement-driven step
@@ -100,6 +102,7 @@ impl Default for NewtonOptions {
             max_increment_norm: 10.0,
             rounding_floor_factor: 10.0,
             first_tangent: FirstTangent::Converged,
+            linear: crate::linear::LinearChoice::default(),
         }
     }
 }

@@ -52,6 +52,51 @@ pub struct StepReport<const D: usize> {
     /// converged state ([`crate::FirstTangent::Converged`]): one
     /// assembly and solve more than `residuals` counts.
     pub linearised_start: bool,
+    /// Wall-clock seconds of each stage over the step (all iterations).
+    pub times: StageTimes,
+    /// Iterations of the iterative linear solver over the step (0 with a
+    /// direct solver).
+    pub linear_iterations: usize,
+}
+
+/// Wall-clock seconds per stage of a load step, summed over its Newton
+/// iterations: where a run's time goes (`docs/src/benchmarks/linear.md`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StageTimes {
+    /// Moving the mesh, locating the points and evaluating their basis
+    /// functions (once per step).
+    pub basis: f64,
+    /// Constraints, node numbering, patches, the sparsity pattern and the
+    /// linear solver's symbolic analysis (once per step).
+    pub system: f64,
+    /// $\Delta F$, the locking treatment and the constitutive update
+    /// (every iteration, with backtracking).
+    pub material: f64,
+    /// The internal force.
+    pub force: f64,
+    /// The consistent tangents (and a patch treatment's coupling vectors).
+    pub tangent: f64,
+    /// The sparse stiffness.
+    pub stiffness: f64,
+    /// The linear solves (factorisation or Krylov iterations), the
+    /// linearised start's included.
+    pub solve: f64,
+    /// Committing the converged state and moving the mesh to the end.
+    pub commit: f64,
+}
+
+impl StageTimes {
+    /// The sum of the stages.
+    pub fn total(&self) -> f64 {
+        self.basis
+            + self.system
+            + self.material
+            + self.force
+            + self.tangent
+            + self.stiffness
+            + self.solve
+            + self.commit
+    }
 }
 
 impl<const D: usize> StepReport<D> {

@@ -87,6 +87,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 .assign(&self.mesh, input, &mut self.patches.assignment)?;
             self.patches.build(sys);
             sys.build_patch_neighbours(&self.patches);
+            self.patches.build_placement(sys);
         } else {
             sys.build_neighbours();
         }

@@ -105,26 +105,7 @@ impl LinearSolver for FaerDirect {
         row_idx: &[usize],
         symmetric: bool,
     ) -> Result<(), LinearSolveError> {
-        let invalid = |reason| LinearSolveError::InvalidPattern { n, reason };
-        if col_ptr.len() != n + 1 || col_ptr.first() != Some(&0) {
-            return Err(invalid(
-                "column pointers must have n + 1 entries starting at 0",
-            ));
-        }
-        if col_ptr.windows(2).any(|w| w[0] > w[1]) || col_ptr[n] != row_idx.len() {
-            return Err(invalid(
-                "column pointers must ascend to the number of entries",
-            ));
-        }
-        let sorted = (0..n).all(|c| {
-            let rows = &row_idx[col_ptr[c]..col_ptr[c + 1]];
-            rows.windows(2).all(|w| w[0] < w[1]) && rows.iter().all(|&r| r < n)
-        });
-        if !sorted {
-            return Err(invalid(
-                "rows must ascend strictly within each column and be < n",
-            ));
-        }
+        super::check_pattern(n, col_ptr, row_idx)?;
         self.last = None;
         let pattern =
             SymbolicSparseColMat::new_checked(n, n, col_ptr.to_vec(), None, row_idx.to_vec());
@@ -170,20 +151,7 @@ impl LinearSolver for FaerDirect {
         let par = self.par;
         let st = self.state.as_mut().ok_or(LinearSolveError::NotAnalysed)?;
         let n = st.pattern.nrows();
-        if values.len() != st.pattern.row_idx().len() {
-            return Err(LinearSolveError::Dimension {
-                what: "values",
-                expected: st.pattern.row_idx().len(),
-                got: values.len(),
-            });
-        }
-        if rhs.len() != n {
-            return Err(LinearSolveError::Dimension {
-                what: "right-hand side entries",
-                expected: n,
-                got: rhs.len(),
-            });
-        }
+        super::check_dimensions(st.pattern.row_idx().len(), n, values, rhs)?;
         if n == 0 {
             self.last = Some(Factorisation::Cholesky);
             return Ok(Factorisation::Cholesky);

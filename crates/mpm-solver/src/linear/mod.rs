@@ -10,9 +10,16 @@
 //! implements the same two calls. Parallelism is a parameter of the
 //! implementation ([`FaerDirect::new`]), never a process-global setting.
 
+mod choice;
 mod faer_direct;
+mod faer_iterative;
 
+pub use choice::{
+    AutoLinear, DEFAULT_MAX_DIRECT_DOFS_2D, DEFAULT_MAX_DIRECT_DOFS_3D, LinearChoice,
+    MAX_FALLBACK_DOFS,
+};
 pub use faer_direct::FaerDirect;
+pub use faer_iterative::{FaerIterative, IterativeOptions};
 
 use thiserror::Error;
 
@@ -24,6 +31,8 @@ pub enum Factorisation {
     Cholesky,
     /// Sparse LU with partial pivoting.
     Lu,
+    /// A preconditioned Krylov method ([`FaerIterative`]).
+    Iterative,
 }
 
 /// Why a linear solve failed; every variant says where.
@@ -66,6 +75,16 @@ pub enum LinearSolveError {
         /// `"symbolic analysis"` or `"numeric factorisation"`.
         stage: &'static str,
     },
+    /// The iterative solver did not reach its tolerance.
+    #[error(
+        "the iterative solver did not converge in {iterations} iterations (relative residual {relative_residual:.3e})"
+    )]
+    NotConverged {
+        /// Iterations made.
+        iterations: usize,
+        /// $\|b - Kx\|/\|b\|$ reached.
+        relative_residual: f64,
+    },
     /// The solution has a non-finite entry: the stiffness is singular or
     /// its values are not finite.
     #[error(
@@ -77,6 +96,61 @@ pub enum LinearSolveError {
         /// First free dof with a non-finite value.
         dof: usize,
     },
+}
+
+/// Checks a compressed-sparse-column pattern (the part of
+/// [`LinearSolver::analyse`] every implementation shares).
+pub(crate) fn check_pattern(
+    n: usize,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+) -> Result<(), LinearSolveError> {
+    let invalid = |reason| LinearSolveError::InvalidPattern { n, reason };
+    if col_ptr.len() != n + 1 || col_ptr.first() != Some(&0) {
+        return Err(invalid(
+            "column pointers must have n + 1 entries starting at 0",
+        ));
+    }
+    if col_ptr.windows(2).any(|w| w[0] > w[1]) || col_ptr[n] != row_idx.len() {
+        return Err(invalid(
+            "column pointers must ascend to the number of entries",
+        ));
+    }
+    let sorted = (0..n).all(|c| {
+        let rows = &row_idx[col_ptr[c]..col_ptr[c + 1]];
+        rows.windows(2).all(|w| w[0] < w[1]) && rows.iter().all(|&r| r < n)
+    });
+    if !sorted {
+        return Err(invalid(
+            "rows must ascend strictly within each column and be < n",
+        ));
+    }
+    Ok(())
+}
+
+/// Checks the lengths handed to [`LinearSolver::solve`] against an
+/// analysed pattern of `nnz` entries and `n` rows.
+pub(crate) fn check_dimensions(
+    nnz: usize,
+    n: usize,
+    values: &[f64],
+    rhs: &[f64],
+) -> Result<(), LinearSolveError> {
+    if values.len() != nnz {
+        return Err(LinearSolveError::Dimension {
+            what: "values",
+            expected: nnz,
+            got: values.len(),
+        });
+    }
+    if rhs.len() != n {
+        return Err(LinearSolveError::Dimension {
+            what: "right-hand side entries",
+            expected: n,
+            got: rhs.len(),
+        });
+    }
+    Ok(())
 }
 
 /// A linear solver for the stiffness of a load step (module docs).
@@ -111,4 +185,10 @@ pub trait LinearSolver: Send + std::fmt::Debug {
 
     /// Number of stored entries of the analysed pattern.
     fn nnz(&self) -> usize;
+
+    /// Iterations of the last solve for an iterative method (0 for a
+    /// direct one).
+    fn last_iterations(&self) -> usize {
+        0
+    }
 }
