@@ -86,6 +86,9 @@ pub struct AutoLinear {
     use_direct: bool,
     /// The step's pattern, kept for a fallback to the direct solver.
     pattern: Option<(usize, Vec<usize>, Vec<usize>, bool)>,
+    /// The right-hand side of the current solve, for the fallback (kept
+    /// between iterations: no allocation per solve).
+    b: Vec<f64>,
 }
 
 impl AutoLinear {
@@ -97,6 +100,7 @@ impl AutoLinear {
             iterative: FaerIterative::new(faer::Par::Seq, options),
             use_direct: true,
             pattern: None,
+            b: Vec::new(),
         }
     }
 
@@ -133,19 +137,21 @@ impl LinearSolver for AutoLinear {
         if self.use_direct {
             return self.direct.solve(values, rhs);
         }
-        let b = self.pattern.as_ref().map(|_| rhs.to_vec());
+        if self.pattern.is_some() {
+            self.b.clear();
+            self.b.extend_from_slice(rhs);
+        }
         match self.iterative.solve(values, rhs) {
             Err(
                 e
                 @ (LinearSolveError::NotConverged { .. } | LinearSolveError::SingularPivot { .. }),
             ) => {
-                let (Some((n, col_ptr, row_idx, symmetric)), Some(b)) = (self.pattern.take(), b)
-                else {
+                let Some((n, col_ptr, row_idx, symmetric)) = self.pattern.take() else {
                     return Err(e);
                 };
                 self.direct.analyse(n, &col_ptr, &row_idx, symmetric)?;
                 self.use_direct = true;
-                rhs.copy_from_slice(&b);
+                rhs.copy_from_slice(&self.b);
                 self.direct.solve(values, rhs)
             }
             other => other,
