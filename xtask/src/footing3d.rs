@@ -6,13 +6,11 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::{Context, Result};
-use mpm_cases::run::{RunControl, RunOutput};
-use mpm_cases::scene::Problem;
+use anyhow::Result;
 
-use crate::machine::{measured, print_run};
 use crate::markdown::Table;
-use crate::plot::{Axis, Figure, Line, Marker, PALETTE, Series};
+use crate::plot::{Axis, Figure};
+use crate::scene_run::{self, Run};
 
 /// The scene the section runs (the full mesh; the quick mode coarsens it).
 const SCENE: &str = include_str!("../../scenes/wang2021_footing.toml");
@@ -29,21 +27,7 @@ const K: f64 = 0.85e6 / std::f64::consts::SQRT_2;
 /// `crates/mpm-cases/tests/scenes.rs`'s.
 const QUICK_MESH: &str = "mesh.coordinates=[[0.0, 0.25, 0.8, 2.1, 5.0], [0.0, 0.25, 0.8, 2.1, 5.0], [0.0, 2.9, 4.2, 4.75, 5.0]]";
 
-/// One run: the footing pressure / k after every step (with the
-/// settlement), its counts and time, or why it failed.
-struct Curve {
-    label: &'static str,
-    points: Vec<(f64, f64)>,
-    elements: usize,
-    material_points: usize,
-    iterations: usize,
-    max_iterations: usize,
-    seconds: f64,
-    peak_mb: Option<f64>,
-    failure: Option<String>,
-}
-
-fn run(full: bool, fpatch: bool) -> Result<Curve> {
+fn run(full: bool, fpatch: bool) -> Result<Run> {
     let mut overrides = Vec::new();
     if !full {
         overrides.push(QUICK_MESH.to_owned());
@@ -51,56 +35,21 @@ fn run(full: bool, fpatch: bool) -> Result<Curve> {
     if fpatch {
         overrides.push("solver.locking=\"fpatch\"".to_owned());
     }
-    let (scene, src) = mpm_cases::scene::parse(SCENE, "scenes/wang2021_footing.toml", &overrides)
-        .context("parsing the footing scene")?;
-    let problem = Problem::<3>::build_in(&scene, &src, 0, Path::new(""))
-        .context("building the footing scene")?;
-    let footing = problem
-        .reactions
-        .iter()
-        .find(|r| r.name == "footing")
-        .cloned()
-        .context("the footing scene has no `footing` reaction")?;
-    let elements = match &problem.mesh {
-        mpm_cases::scene::build::SceneMesh::Simplex(m) => m.element_count(),
-        mpm_cases::scene::build::SceneMesh::Grid(_) => 0,
-    };
     let label = if fpatch { "F-patch" } else { "standard MPM" };
-    let mut curve = Curve {
-        label,
-        points: vec![(0.0, 0.0)],
-        elements,
-        material_points: problem.len(),
-        iterations: 0,
-        max_iterations: 0,
-        seconds: 0.0,
-        peak_mb: None,
-        failure: None,
-    };
-    let (result, seconds, peak): (Result<RunOutput<3>, _>, _, _) = measured(|| {
-        mpm_cases::scene::run(&problem, &RunControl::default(), |_, report, _| {
-            let force = footing.total(report)[2];
-            curve.points.push((
+    // The footing pressure / k after every step, against the settlement.
+    scene_run::run(
+        SCENE,
+        "scenes/wang2021_footing.toml",
+        &overrides,
+        label.to_owned(),
+        "footing",
+        |footing, report| {
+            (
                 1e3 * report.lambda1 * SETTLEMENT,
-                force.abs() / (HALF_EDGE * HALF_EDGE) / K,
-            ));
-            curve.iterations += report.residuals.len();
-            curve.max_iterations = curve.max_iterations.max(report.residuals.len());
-            Ok(())
-        })
-    });
-    (curve.seconds, curve.peak_mb) = (seconds, peak);
-    if let Err(e) = result {
-        curve.failure = Some(e.to_string());
-    }
-    print_run(
-        &format!("footing 3D, {label}"),
-        curve.points.len() - 1,
-        curve.iterations,
-        curve.seconds,
-        curve.failure.as_deref(),
-    );
-    Ok(curve)
+                footing.total(report)[2].abs() / (HALF_EDGE * HALF_EDGE) / K,
+            )
+        },
+    )
 }
 
 /// Slope of the pressure over the last quarter of the settlement against
@@ -156,7 +105,7 @@ pub fn section(full: bool, img: &Path) -> Result<String> {
         "pressure / k at 2 mm",
         "late slope / initial slope",
     ]);
-    let at = |c: &Curve, s: f64| {
+    let at = |c: &Run, s: f64| {
         c.points
             .iter()
             .find(|p| (p.0 - s).abs() < 1e-9)
@@ -180,18 +129,7 @@ pub fn section(full: bool, img: &Path) -> Result<String> {
         ]);
     }
     md.push_str(&table.render());
-    let series = curves
-        .iter()
-        .enumerate()
-        .map(|(i, c)| Series {
-            label: c.label.to_owned(),
-            points: c.points.clone(),
-            color: PALETTE[i],
-            marker: Some(Marker::CYCLE[i]),
-            filled: i == 0,
-            line: Line::Solid,
-        })
-        .collect();
+    let series = scene_run::series(&curves);
     let figure = Figure {
         title: "Footing with small deformation (Wang 2021 §5.1)".into(),
         x: Axis::linear("footing settlement (mm)"),
@@ -210,10 +148,10 @@ pub fn section(full: bool, img: &Path) -> Result<String> {
 
 /// What the two curves show, from the runs; `beyond` is the size of the
 /// cell beyond the footing's edge (m).
-fn reading(curves: &[Curve; 2], beyond: f64) -> String {
+fn reading(curves: &[Run; 2], beyond: f64) -> String {
     let [standard, patched] = curves;
-    let end = |c: &Curve| c.points.last().map_or(f64::NAN, |p| p.1);
-    let stopped = |c: &Curve| {
+    let end = |c: &Run| c.points.last().map_or(f64::NAN, |p| p.1);
+    let stopped = |c: &Run| {
         c.failure.as_ref().map(|f| {
             format!(
                 "{} stopped after {} mm of settlement ({} steps): {f}.",

@@ -31,11 +31,14 @@
 mod column_table;
 mod coombs2020;
 mod footing3d;
+mod indentation;
 mod locking;
 mod machine;
 mod markdown;
+mod plate;
 mod plot;
 mod reference_values;
+mod scene_run;
 mod vane;
 mod wang2021;
 

@@ -121,6 +121,11 @@ pub enum SimplexRule {
     /// rule's own weights include a negative one, which cannot be a
     /// volume). 3D only; in 2D it falls back to `Subdivision(3)`.
     Keast11,
+    /// The 4 points of the degree-2 Gauss rule on a tetrahedron (barycentric
+    /// coordinates $(5+3\sqrt5)/20$ and $(5-\sqrt5)/20$, equal weights;
+    /// Wang et al. 2021 §5.5 use 1, 4 and 11 points per element), volumes
+    /// $V/4$. 3D only; in 2D it falls back to `Subdivision(2)`.
+    Gauss4,
 }
 
 impl SimplexRule {
@@ -145,6 +150,18 @@ impl SimplexRule {
                 out
             }
             (SimplexRule::Keast11, _) => SimplexRule::Subdivision(3).points::<D>(),
+            (SimplexRule::Gauss4, 3) => {
+                let root5 = 5.0f64.sqrt();
+                let (a, b) = ((5.0 + 3.0 * root5) / 20.0, (5.0 - root5) / 20.0);
+                (0..4)
+                    .map(|k| {
+                        let mut w = [b; 4];
+                        w[k] = a;
+                        (w, 0.25)
+                    })
+                    .collect()
+            }
+            (SimplexRule::Gauss4, _) => SimplexRule::Subdivision(2).points::<D>(),
             (SimplexRule::Subdivision(n), _) => subdivision_centroids::<D>(n.max(1)),
         }
     }
@@ -231,6 +248,7 @@ mod tests {
             check::<3>(SimplexRule::Subdivision(n), n * n * n);
         }
         check::<3>(SimplexRule::Keast11, 11);
+        check::<3>(SimplexRule::Gauss4, 4);
         // Two divisions of a triangle: the three corner sub-triangles and
         // the middle one.
         let mut two: Vec<[f64; 3]> = SimplexRule::Subdivision(2)
@@ -246,6 +264,19 @@ mod tests {
                 got.iter().zip(want).all(|(x, y)| (x - y).abs() < 1e-14),
                 "{two:?}"
             );
+        }
+    }
+
+    #[test]
+    fn gauss4_integrates_quadratics_exactly() {
+        // ∫ λ_i λ_j dV / V = (1 + δ_ij) / 20 on any tetrahedron.
+        let points = SimplexRule::Gauss4.points::<3>();
+        for i in 0..4 {
+            for j in 0..4 {
+                let got: f64 = points.iter().map(|(w, s)| w[i] * w[j] * s).sum();
+                let want = if i == j { 0.1 } else { 0.05 };
+                assert!((got - want).abs() < 1e-15, "{i}{j}: {got} vs {want}");
+            }
         }
     }
 }

@@ -197,7 +197,7 @@ pub struct Loads<const D: usize> {
 /// Everything a run produced.
 #[derive(Debug, Clone)]
 pub struct RunOutput<const D: usize> {
-    /// The final state.
+    /// The final state, with the moving mesh's nodes when the mesh moves.
     pub last: Snapshot,
     /// Reports of the converged steps (of this session, when resumed).
     pub reports: Vec<StepReport<D>>,
@@ -358,6 +358,8 @@ where
         None => (RunState::start(&setup.stepping), 0.0),
     };
     let mut reports = Vec::new();
+    // The moving mesh after the last step, for `RunOutput::last`.
+    let mut last_mesh = None;
     let mut observer_time = 0.0;
     let start = Instant::now();
     let summary = solver.run_from(
@@ -391,13 +393,17 @@ where
                 snapshot.tangent = now.stiffness.map(|k| k.to_sprs()).transpose()?;
             }
             observer(step, report, &snapshot)?;
+            last_mesh = snapshot.mesh_nodes.take();
             observer_time += t.elapsed().as_secs_f64();
             Ok(())
         },
     )?;
     let wall_time_s = earlier_time + start.elapsed().as_secs_f64() - observer_time;
     Ok(RunOutput {
-        last: Snapshot::of(&points, 1.0),
+        last: Snapshot {
+            mesh_nodes: last_mesh,
+            ..Snapshot::of(&points, 1.0)
+        },
         reports,
         summary,
         wall_time_s,

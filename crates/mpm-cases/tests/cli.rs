@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+
 fn mpm(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_mpm"))
         .args(args)
@@ -289,7 +291,10 @@ fn resume_repeats_the_uninterrupted_run() {
         for (name, text) in &a {
             // Wall-clock columns differ between any two runs.
             let (x, y) = if name.ends_with("steps.csv") {
-                (without_timings(text), without_timings(&b[name]))
+                (
+                    common::without_timings(text),
+                    common::without_timings(&b[name]),
+                )
             } else {
                 (text.clone(), b[name].clone())
             };
@@ -496,22 +501,4 @@ fn export_tangent_writes_matrix_market_per_step() {
     );
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&plain);
-}
-
-/// A `steps.csv` without its wall-clock columns (`seconds*`).
-fn without_timings(csv: &str) -> String {
-    let header: Vec<&str> = csv.lines().next().unwrap_or_default().split(',').collect();
-    let keep: Vec<bool> = header.iter().map(|c| !c.starts_with("seconds")).collect();
-    assert!(keep.iter().any(|k| !k), "steps.csv has no timing columns");
-    csv.lines()
-        .map(|line| {
-            line.split(',')
-                .zip(&keep)
-                .filter(|(_, k)| **k)
-                .map(|(v, _)| v)
-                .collect::<Vec<_>>()
-                .join(",")
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
 }

@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use mpm_mesh::{RegularGrid, SimplexMesh};
 use mpm_solver::{
     BodyForcePath, Constraints, LoadStepping, MeshMotion, MeshMotionError, MovableMesh, MovingMesh,
-    NewtonOptions, Rotation, StepView, Stretch,
+    NewtonOptions, Rotation, StepView, Stretch, Translation,
 };
 use nalgebra::SVector;
 use toml::Spanned;
@@ -425,7 +425,17 @@ fn lookup(
     section: &str,
     src: &SceneSource,
 ) -> Result<usize, CasesError> {
-    map.get(name.get_ref()).copied().ok_or_else(|| {
+    lookup_ref(map, name, section, src).copied()
+}
+
+/// [`lookup`] for any value, by reference.
+fn lookup_ref<'m, V>(
+    map: &'m BTreeMap<String, V>,
+    name: &Spanned<String>,
+    section: &str,
+    src: &SceneSource,
+) -> Result<&'m V, CasesError> {
+    map.get(name.get_ref()).ok_or_else(|| {
         let known: Vec<&str> = map.keys().map(String::as_str).collect();
         src.at(
             name,
@@ -866,9 +876,14 @@ impl<const D: usize> Problem<D> {
                     if let Some(p) = spec.placement.as_ref()
                         && *p.get_ref() != Placement::Regular
                     {
+                        let name = if *p.get_ref() == Placement::Gauss4 {
+                            "gauss4"
+                        } else {
+                            "keast11"
+                        };
                         return Err(src.at(
                             p,
-                            "placement = keast11 places points in tetrahedra; a body on a grid has placement = regular",
+                            format!("placement = {name} places points in tetrahedra; a body on a grid has placement = regular"),
                         ));
                     }
                     let anchor = match &spec.lattice_origin {
@@ -922,19 +937,26 @@ impl<const D: usize> Problem<D> {
                         ));
                     }
                     let rule = match spec.placement.as_ref() {
-                        Some(p) if *p.get_ref() == Placement::Keast11 => {
+                        Some(p) if *p.get_ref() != Placement::Regular => {
+                            let (rule, name) = match p.get_ref() {
+                                Placement::Gauss4 => (crate::body::SimplexRule::Gauss4, "gauss4"),
+                                _ => (crate::body::SimplexRule::Keast11, "keast11"),
+                            };
                             if D != 3 {
                                 return Err(src.at(
                                     p,
-                                    "placement = keast11 is a rule for tetrahedra (3D meshes)",
+                                    format!(
+                                        "placement = {name} is a rule for tetrahedra (3D meshes)"
+                                    ),
                                 ));
                             }
-                            crate::body::SimplexRule::Keast11
+                            rule
                         }
                         _ => crate::body::SimplexRule::Subdivision(ppc),
                     };
                     let per_element = match rule {
                         crate::body::SimplexRule::Keast11 => 11,
+                        crate::body::SimplexRule::Gauss4 => 4,
                         crate::body::SimplexRule::Subdivision(_) => {
                             ppc.checked_pow(D as u32).unwrap_or(usize::MAX)
                         }
@@ -1126,16 +1148,7 @@ impl<const D: usize> Problem<D> {
                     ),
                 ));
             }
-            sets.get(name.get_ref()).ok_or_else(|| {
-                src.at(
-                    name,
-                    format!(
-                        "no node set named `{}`; the scene has: {}",
-                        name.get_ref(),
-                        sets.keys().cloned().collect::<Vec<_>>().join(", ")
-                    ),
-                )
-            })
+            lookup_ref(&sets, name, "node set", src)
         };
 
         // Boundaries (later conditions replace earlier ones on shared dofs).
@@ -2023,6 +2036,8 @@ pub enum SceneMotion<const D: usize> {
     Stretch(Stretch),
     /// `rotation`.
     Rotation(Rotation<D>),
+    /// `translation`.
+    Translation(Translation<D>),
 }
 
 impl<const D: usize> MeshMotion<D> for SceneMotion<D> {
@@ -2031,6 +2046,7 @@ impl<const D: usize> MeshMotion<D> for SceneMotion<D> {
         match self {
             SceneMotion::Stretch(m) => MeshMotion::<D>::position(m, node, x0, lambda),
             SceneMotion::Rotation(m) => m.position(node, x0, lambda),
+            SceneMotion::Translation(m) => m.position(node, x0, lambda),
         }
     }
 }
@@ -2062,7 +2078,61 @@ fn motion_of<const D: usize>(
             Ok(())
         }
     };
+    let named = |name: &Spanned<String>| lookup_ref(sets, name, "node set", src);
+    if !matches!(spec.kind.get_ref(), MotionKind::Translation) {
+        refuse(
+            spec.displacement.is_some(),
+            "displacement",
+            "stretch or rotation",
+        )?;
+        refuse(spec.carried.is_some(), "carried", "stretch or rotation")?;
+        refuse(spec.fixed.is_some(), "fixed", "stretch or rotation")?;
+    }
     let (motion, default_components) = match spec.kind.get_ref() {
+        MotionKind::Translation => {
+            for (present, key) in [
+                (spec.axis.is_some(), "axis"),
+                (spec.extension.is_some(), "extension"),
+                (spec.length.is_some(), "length"),
+                (spec.origin.is_some(), "origin"),
+                (spec.centre.is_some(), "centre"),
+                (spec.angle.is_some(), "angle"),
+            ] {
+                refuse(present, key, "translation")?;
+            }
+            let Some(d) = &spec.displacement else {
+                return Err(src.at(
+                    &spec.kind,
+                    "a translation needs `displacement` (m, one number per axis, at load factor 1)",
+                ));
+            };
+            let displacement = point::<D>(d, "translation `displacement`", src)?;
+            if !displacement.iter().all(|v| v.is_finite()) {
+                return Err(src.at(d, "translation `displacement` must be finite"));
+            }
+            let Some(fixed_name) = &spec.fixed else {
+                return Err(src.at(
+                    &spec.kind,
+                    "a translation needs `fixed`: the node set that stays (the mesh between it and the carried set is compressed or stretched)",
+                ));
+            };
+            let carried_name = spec.carried.as_ref().unwrap_or(&spec.driven);
+            let (carried, fixed) = (named(carried_name)?, named(fixed_name)?);
+            let translation = Translation::new(initial, carried, fixed, displacement)
+                .ok_or_else(|| {
+                    src.at(
+                        fixed_name,
+                        format!(
+                            "a translation needs non-empty carried (`{}`, {} nodes) and fixed (`{}`, {} nodes) sets with no node in both",
+                            carried_name.get_ref(),
+                            carried.len(),
+                            fixed_name.get_ref(),
+                            fixed.len()
+                        ),
+                    )
+                })?;
+            (SceneMotion::Translation(translation), [true; D])
+        }
         MotionKind::Stretch => {
             refuse(spec.centre.is_some(), "centre", "stretch")?;
             refuse(spec.angle.is_some(), "angle", "stretch")?;
@@ -2137,16 +2207,7 @@ fn motion_of<const D: usize>(
             (SceneMotion::Rotation(rotation), [true; D])
         }
     };
-    let driven = sets.get(spec.driven.get_ref()).ok_or_else(|| {
-        src.at(
-            &spec.driven,
-            format!(
-                "no node set named `{}`; the scene has: {}",
-                spec.driven.get_ref(),
-                sets.keys().cloned().collect::<Vec<_>>().join(", ")
-            ),
-        )
-    })?;
+    let driven = named(&spec.driven)?;
     let components = match &spec.components {
         None => default_components,
         Some(list) => {

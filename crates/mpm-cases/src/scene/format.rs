@@ -144,6 +144,11 @@ pub enum MotionKind {
     /// through a centre (3D) by $\lambda\,\Theta$ (Wang et al. 2021 §5.5:
     /// "rotate the whole mesh with the vane").
     Rotation,
+    /// Translation of the `carried` nodes by $\lambda\,\mathbf d$ with the
+    /// `fixed` nodes held and every other node interpolated by its
+    /// distances to the two sets (Wang et al. 2021 §5.2: the empty mesh
+    /// above a footing moves with it, the mesh below is compressed).
+    Translation,
 }
 
 /// `[mesh.motion]`: the background mesh follows the load factor, and the
@@ -177,10 +182,22 @@ pub struct MotionSpec {
     /// counter-clockwise about the axis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angle: Option<Spanned<f64>>,
+    /// `translation`: the displacement $\mathbf d$ at load factor 1 (m,
+    /// $D$ numbers).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub displacement: Option<Spanned<Vec<f64>>>,
+    /// `translation`: node set that moves rigidly by $\lambda\,\mathbf d$
+    /// (default: `driven`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub carried: Option<Spanned<String>>,
+    /// `translation`: node set that stays where it is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fixed: Option<Spanned<String>>,
     /// Node set whose nodes move with the mesh.
     pub driven: Spanned<String>,
     /// Components of the driven nodes that are prescribed (default: the
-    /// axis for a stretch, every component for a rotation).
+    /// axis for a stretch, every component for a rotation or a
+    /// translation).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub components: Option<Spanned<Vec<String>>>,
 }
@@ -253,8 +270,9 @@ pub struct BodySpec {
     #[serde(default = "default_points_per_cell")]
     pub points_per_cell: Spanned<usize>,
     /// How the points are placed: `regular` (the lattice or the
-    /// sub-simplices of `points_per_cell`, the default) or `keast11`
-    /// (Keast's 11-point rule in every tetrahedron).
+    /// sub-simplices of `points_per_cell`, the default), `gauss4` (the
+    /// 4-point Gauss rule in every tetrahedron) or `keast11` (Keast's
+    /// 11-point rule).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub placement: Option<Spanned<Placement>>,
     /// Grids: a point the lattice of points is anchored at (the lower
@@ -273,6 +291,9 @@ pub enum Placement {
     Regular,
     /// Keast's 11 points per tetrahedron, equal volumes (3D simplex meshes).
     Keast11,
+    /// The 4 Gauss points of the degree-2 rule per tetrahedron, equal
+    /// volumes (3D simplex meshes).
+    Gauss4,
 }
 
 fn default_points_per_cell() -> Spanned<usize> {

@@ -132,3 +132,21 @@ pub fn element<'a>(doc: &'a [Element], name: &str) -> &'a Element {
         .find(|e| e.name == name)
         .unwrap_or_else(|| panic!("no element {name}"))
 }
+
+/// A `steps.csv` without its wall-clock columns (`seconds*`).
+pub fn without_timings(csv: &str) -> String {
+    let header: Vec<&str> = csv.lines().next().unwrap_or_default().split(',').collect();
+    let keep: Vec<bool> = header.iter().map(|c| !c.starts_with("seconds")).collect();
+    assert!(keep.iter().any(|k| !k), "steps.csv has no timing columns");
+    csv.lines()
+        .map(|line| {
+            line.split(',')
+                .zip(&keep)
+                .filter(|(_, k)| **k)
+                .map(|(v, _)| v)
+                .collect::<Vec<_>>()
+                .join(",")
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
