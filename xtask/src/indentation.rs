@@ -142,6 +142,35 @@ fn reading(runs: &[Run; 2]) -> String {
             );
         }
     }
+    // Both curves at the largest settlement both reached (the other
+    // interpolated linearly between its steps).
+    let reached = standard
+        .points
+        .last()
+        .zip(patched.points.last())
+        .map(|(a, b)| a.0.min(b.0));
+    if let Some(u) = reached.filter(|&u| u > 0.0) {
+        let at = |r: &Run| {
+            r.points.windows(2).find_map(|w| {
+                (w[0].0 <= u && u <= w[1].0 + 1e-12).then(|| {
+                    let t = if w[1].0 > w[0].0 {
+                        (u - w[0].0) / (w[1].0 - w[0].0)
+                    } else {
+                        1.0
+                    };
+                    w[0].1 + t * (w[1].1 - w[0].1)
+                })
+            })
+        };
+        if let (Some(s), Some(f)) = (at(standard), at(patched)) {
+            let _ = write!(
+                text,
+                "At {u:.3} m, the largest settlement both reached, standard MPM carries {s:.1} MN \
+                 and F-patch {f:.1} MN ({:+.1} %). ",
+                100.0 * (f / s - 1.0)
+            );
+        }
+    }
     if standard.failure.is_none() && patched.failure.is_none() {
         let _ = write!(
             text,
@@ -157,7 +186,7 @@ fn reading(runs: &[Run; 2]) -> String {
         );
     }
     text.push_str(
-        "`crates/mpm-cases/tests/scenes.rs` checks the moving mesh (the footing's nodes at the \
+        "`crates/mpm-cases/tests/wang2021_3d.rs` checks the moving mesh (the footing's nodes at the \
          settled ground, the bottom in place), the doubling of the steps and F-patch below \
          standard MPM on the quick mesh.\n\n",
     );

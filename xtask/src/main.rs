@@ -12,10 +12,12 @@
 //!   `docs/src/reproduction/img/` ([`coombs2020`]).
 //! - `reproduce wang2021 [--full]`: the simple stretch on tetrahedra with a
 //!   moving mesh (Table 1, standard MPM and F-patch), the small-deformation
-//!   footing in 3D (§5.1, Fig. 8C), the vane slice (§5.5, Fig. 18C) and
-//!   point location by walking against brute force (§5.7), written to
+//!   footing in 3D (§5.1, Fig. 8C), the elastic indentation (§5.2,
+//!   Fig. 11C), the double-notched plate (§5.4, Figs. 15C, 16), the vane
+//!   slice and the full vane (§5.5–5.6, Figs. 18C, 20C, 21) and point
+//!   location by walking against brute force (§5.7), written to
 //!   `docs/src/reproduction/wang2021.md` ([`wang2021`], [`footing3d`],
-//!   [`vane`]).
+//!   [`indentation`], [`plate`], [`vane`]).
 //! - `reproduce locking`: Cook's membrane against refinement for standard
 //!   MPM, F-patch and F-bar, written to `docs/src/reproduction/locking.md`
 //!   ([`locking`]).

@@ -203,7 +203,7 @@ fn reading(runs: &[(f64, Run, Run)]) -> String {
     };
     let _ = write!(
         text,
-        "The largest reaction {} with h for standard MPM and {} for F-patch. ",
+        "As h decreases the largest reaction {} with standard MPM and {} with F-patch. ",
         if falls(|r| &r.1) {
             "falls"
         } else {
@@ -232,7 +232,7 @@ fn reading(runs: &[(f64, Run, Run)]) -> String {
          {plane_strain:.2} kN in plane strain (the gross section yielding in tension, 2k over \
          twice the ligament, below Prandtl's (2 + π) k on the ligament); a plate as thick as its \
          ligament lies between. With F-patch the reaction passes a maximum and then falls as \
-         the ligament necks. `crates/mpm-cases/tests/scenes.rs` asserts the three findings \
+         the ligament necks. `crates/mpm-cases/tests/wang2021_3d.rs` asserts the three findings \
          on h = 2 and 1 mm with one point per element.\n\n",
     );
     text

@@ -5,7 +5,7 @@
 //! `LogStrainLaw`) and one line in the [`register_laws!`] call below.
 
 use mpm_constitutive::{
-    HenckyElastic, LogStrainLaw, MaterialSet, Tagged, VonMises, VonMisesHistory,
+    HenckyElastic, LogStrainLaw, MaterialSet, NeoHookean, Tagged, VonMises, VonMisesHistory,
 };
 use mpm_solver::{Flat, SolverError};
 
@@ -136,6 +136,8 @@ fn yield_stress(p: &MaterialParams, model: &str) -> Result<f64, SolverError> {
 register_laws! {
     /// Hencky elasticity (Coombs et al. 2020 §2).
     Hencky => "hencky", |p| HenckyElastic::new(p.youngs_modulus, p.poisson_ratio);
+    /// Compressible Neo-Hookean elasticity (Bonet & Wood eq. 6.27).
+    NeoHookean => "neo_hookean", |p| NeoHookean::new(p.youngs_modulus, p.poisson_ratio);
     /// Von Mises elasto-plasticity with linear hardening (eq. 16).
     VonMises => "von_mises", |p| VonMises::new(
         p.youngs_modulus,
@@ -173,6 +175,8 @@ mod tests {
         p.yield_stress = Some(1e3);
         let vm = dispatch_law(MaterialModel::VonMises, &p, Name).expect("von mises");
         assert!(vm.ends_with("VonMises"), "{vm}");
+        let nh = dispatch_law(MaterialModel::NeoHookean, &p, Name).expect("neo-hookean");
+        assert!(nh.ends_with("NeoHookean"), "{nh}");
         p.poisson_ratio = 0.5;
         assert!(matches!(
             dispatch_law(MaterialModel::Hencky, &p, Name),

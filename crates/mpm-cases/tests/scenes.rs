@@ -1276,3 +1276,86 @@ fn scene_runs_resume_to_the_same_results() {
         assert_eq!(read(&whole), read(&parts), "{file}");
     }
 }
+
+/// A block under uniaxial strain with `model = "neo_hookean"`: rollers on
+/// both sides and the base, the top pushed down 0.3 m in 5 steps, so that
+/// F = diag(1, λ) with λ = 0.7 everywhere. The top's reaction per unit
+/// width is σ_yy = τ_yy/λ with τ_yy = μ(λ² − 1) + λ_L ln λ (Bonet & Wood
+/// eq. 6.29), exact for standard MPM on a homogeneous state.
+#[test]
+fn neo_hookean_scene_matches_uniaxial_strain() {
+    let text = r#"[mesh]
+origin = [0.0, 0.0]
+size = [1.0, 1.0]
+cells = [2, 2]
+
+[[material]]
+name = "m"
+model = "neo_hookean"
+youngs_modulus = 1e6
+poisson_ratio = 0.3
+density = 0.0
+
+[[body]]
+name = "b"
+material = "m"
+region = { box = { lower = [0.0, 0.0], upper = [1.0, 1.0] } }
+
+[[boundary]]
+set = "x_min"
+kind = "roller"
+
+[[boundary]]
+set = "x_max"
+kind = "roller"
+
+[[boundary]]
+set = "y_min"
+kind = "roller"
+
+[[boundary]]
+set = "y_max"
+kind = "displacement"
+displacement = { y = -0.3 }
+
+[solver]
+basis = "linear"
+steps = 5
+tolerance = 1e-12
+
+[[output.reaction]]
+name = "top"
+set = "y_max"
+"#;
+    let (scene, src) = scene::parse(text, "neo.toml", &[]).unwrap();
+    let problem = Problem::<2>::build(&scene, &src, 0).unwrap();
+    let top = problem.reactions[0].clone();
+    let mut reaction = 0.0;
+    scene::run(&problem, &RunControl::default(), |_, rep, _| {
+        reaction = top.total(rep)[1];
+        Ok(())
+    })
+    .unwrap();
+    let (e, nu, stretch) = (1e6f64, 0.3f64, 0.7f64);
+    let (lambda, mu) = (
+        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+        e / (2.0 * (1.0 + nu)),
+    );
+    let sigma = (mu * (stretch * stretch - 1.0) + lambda * stretch.ln()) / stretch;
+    // The support pushes down on the compressed block: −σ_yy·1 m.
+    assert!(
+        (reaction + sigma).abs() < 1e-9 * sigma.abs(),
+        "reaction {reaction} against {}",
+        -sigma
+    );
+    // Mixing it with another model is refused (one law type per scene).
+    let mixed = text.replace(
+        "[[body]]",
+        "[[material]]\nname = \"h\"\nmodel = \"hencky\"\nyoungs_modulus = 1e6\npoisson_ratio = 0.3\ndensity = 0.0\n\n[[body]]",
+    );
+    let message = refusal(&mixed);
+    assert!(
+        message.contains("material `h` is hencky but `m` is neo_hookean"),
+        "{message}"
+    );
+}

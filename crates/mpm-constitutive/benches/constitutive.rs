@@ -63,6 +63,16 @@ fn constitutive(c: &mut Criterion) {
             history: (),
         },
     );
+    let neo_hookean = mpm_constitutive::NeoHookean::new(1e6, 0.3).unwrap();
+    bench_law(
+        c,
+        "neo_hookean",
+        &neo_hookean,
+        MaterialState {
+            be: be_n,
+            history: (),
+        },
+    );
     let elastic_vm = VonMises::new(1e6, 0.3, 1e9, 0.0).unwrap();
     bench_law(
         c,

@@ -13,7 +13,8 @@
 //!   $L = \partial\ln b/\partial b$ (eq. A.2).
 //! - [`kinematics`]: $b^{e,tr}$, $B$ (eq. A.2), $\tilde B$ (eq. A.5).
 //! - [`law`]: the plug-point trait [`LogStrainLaw`] for small-strain
-//!   algorithmic laws; [`HenckyElastic`] and [`VonMises`] implement it.
+//!   algorithmic laws; [`HenckyElastic`], [`NeoHookean`] and [`VonMises`]
+//!   implement it.
 //! - [`driver`]: the finite-strain update [`update`] generic over the law,
 //!   and the tangents [`SpatialTangent`] ($a_{ijkl}$, eq. A.1) and
 //!   [`PreviouslyConvergedTangent`] ($\tilde A_{ijkl}$, eqs. A.3–A.6).
@@ -44,6 +45,7 @@ pub mod hencky;
 pub mod kinematics;
 pub mod law;
 pub mod material_set;
+pub mod neo_hookean;
 pub mod spectral;
 pub mod tensor;
 pub mod verification;
@@ -57,6 +59,7 @@ pub use error::{ConstitutiveError, Result};
 pub use hencky::HenckyElastic;
 pub use law::{IsotropicElasticity, LawState, LogStrainLaw};
 pub use material_set::{MaterialSet, Tagged};
+pub use neo_hookean::NeoHookean;
 pub use spectral::{SymSpectral, sym_exp, sym_log};
 pub use tensor::Tensor4;
 pub use von_mises::{VonMises, VonMisesHistory};

@@ -69,6 +69,7 @@ fn von_mises_for(
 // the yield stress E/2 gives elastic and yielding steps over the drawn
 // stretches 0.2–5.
 mpm_constitutive::law_tangent_properties!(hencky_macro, HenckyElastic::new);
+mpm_constitutive::law_tangent_properties!(neo_hookean_macro, mpm_constitutive::NeoHookean::new);
 mpm_constitutive::law_tangent_properties!(von_mises_macro, |e, nu| {
     VonMises::new(e, nu, 0.5 * e, 0.1 * e)
 });

@@ -788,7 +788,7 @@ impl<const D: usize> Problem<D> {
             .materials
             .iter()
             .any(|m| m.model == MaterialModel::VonMises);
-        let mut materials = Vec::new();
+        let mut materials: Vec<BuiltMaterial> = Vec::new();
         for spec in &scene.materials {
             let density = *spec.density.get_ref();
             if density < 0.0 {
@@ -822,6 +822,23 @@ impl<const D: usize> Problem<D> {
             } else {
                 spec.model
             };
+            // The materials of a scene share one law type (one
+            // monomorphised run); Hencky joins von Mises as a von Mises
+            // law that never yields, other mixtures are refused.
+            if let Some(first) = materials.first()
+                && first.model != model
+            {
+                return Err(src.at(
+                    &spec.name,
+                    format!(
+                        "material `{}` is {} but `{}` is {}: the materials of one scene share one model (hencky mixes with von_mises)",
+                        spec.name.get_ref(),
+                        spec.model,
+                        first.name,
+                        first.model
+                    ),
+                ));
+            }
             materials.push(BuiltMaterial {
                 name: spec.name.get_ref().clone(),
                 model,
