@@ -43,7 +43,7 @@ fn run(full: bool, fpatch: bool) -> Result<Run> {
         &overrides,
         label.to_owned(),
         "footing",
-        |footing, report| {
+        |_, footing, report| {
             (
                 1e3 * report.lambda1 * SETTLEMENT,
                 footing.total(report)[2].abs() / (HALF_EDGE * HALF_EDGE) / K,

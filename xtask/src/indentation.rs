@@ -37,7 +37,7 @@ fn run(full: bool, fpatch: bool) -> Result<Run> {
         &overrides,
         label.to_owned(),
         "footing",
-        |footing, report| {
+        |_, footing, report| {
             (
                 report.lambda1 * SETTLEMENT,
                 footing.total(report)[2].abs() / 1e6,

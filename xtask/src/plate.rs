@@ -30,7 +30,7 @@ fn run(h: f64, cells: &str, fpatch: bool) -> Result<Run> {
         "{}, h = {h} mm",
         if fpatch { "F-patch" } else { "standard MPM" }
     );
-    scene_run::run(SCENE, FILE, &overrides, label, "top", |top, report| {
+    scene_run::run(SCENE, FILE, &overrides, label, "top", |_, top, report| {
         (report.lambda1 * STRETCH_MM, top.total(report)[1] / 1e3)
     })
 }

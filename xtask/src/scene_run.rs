@@ -35,6 +35,13 @@ pub struct Run {
     pub peak_mb: Option<f64>,
     /// Why the run stopped early.
     pub failure: Option<String>,
+    /// Per converged step: Newton iterations, seconds, iterative-solver
+    /// iterations.
+    pub steps: Vec<(usize, f64, usize)>,
+    /// The solver's stage times summed over the run.
+    pub times: mpm_solver::StageTimes,
+    /// Free dofs of the last step.
+    pub free_dofs: usize,
 }
 
 impl Run {
@@ -64,14 +71,15 @@ impl Run {
 
 /// Runs the scene `text` (named `file`, relative paths resolved in
 /// `scenes/`) with `overrides`; after every converged step `point` maps the
-/// reaction named `reaction` and the step's report to a point of the curve.
+/// problem, the reaction named `reaction` and the step's report to a point
+/// of the curve.
 pub fn run(
     text: &str,
     file: &str,
     overrides: &[String],
     label: String,
     reaction: &str,
-    mut point: impl FnMut(&ReactionOutput<3>, &StepReport<3>) -> (f64, f64),
+    mut point: impl FnMut(&Problem<3>, &ReactionOutput<3>, &StepReport<3>) -> (f64, f64),
 ) -> Result<Run> {
     let (scene, src) = mpm_cases::scene::parse(text, file, overrides)
         .with_context(|| format!("parsing {file}"))?;
@@ -100,13 +108,29 @@ pub fn run(
         seconds: 0.0,
         peak_mb: None,
         failure: None,
+        steps: Vec::new(),
+        times: mpm_solver::StageTimes::default(),
+        free_dofs: 0,
     };
     let (result, seconds, peak): (Result<RunOutput<3>, _>, _, _) = measured(|| {
         mpm_cases::scene::run(&problem, &RunControl::default(), |_, report, _| {
-            run.points.push(point(&on, report));
+            run.points.push(point(&problem, &on, report));
             run.residuals.push(report.residuals.clone());
             run.iterations += report.iterations();
             run.max_iterations = run.max_iterations.max(report.iterations());
+            let t = &report.times;
+            run.steps
+                .push((report.iterations(), t.total(), report.linear_iterations));
+            let c = &mut run.times;
+            c.basis += t.basis;
+            c.system += t.system;
+            c.material += t.material;
+            c.force += t.force;
+            c.tangent += t.tangent;
+            c.stiffness += t.stiffness;
+            c.solve += t.solve;
+            c.commit += t.commit;
+            run.free_dofs = report.free_dofs;
             Ok(())
         })
     });

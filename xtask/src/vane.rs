@@ -9,34 +9,29 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::{Context, Result};
-use mpm_cases::run::{RunControl, RunOutput};
-use mpm_cases::scene::Problem;
+use anyhow::Result;
 
-use crate::machine::{measured, print_run};
 use crate::markdown::Table;
 use crate::plot::{Axis, Figure, Line, Marker, PALETTE, Series};
+use crate::scene_run::{self, Run};
 
 /// A vane scene: its text, file name and total rotation (rad).
 struct Spec {
     text: &'static str,
     file: &'static str,
     rotation: f64,
-    name: &'static str,
 }
 
 const SLICE: Spec = Spec {
     text: include_str!("../../scenes/wang2021_vane_slice.toml"),
     file: "scenes/wang2021_vane_slice.toml",
     rotation: 8e-4,
-    name: "vane slice",
 };
 
 const FULL: Spec = Spec {
     text: include_str!("../../scenes/wang2021_vane_full.toml"),
     file: "scenes/wang2021_vane_full.toml",
     rotation: 4e-4,
-    name: "full vane",
 };
 
 /// Vane radius and slice height (m); the full vane's blades are 4 r_v high.
@@ -52,24 +47,18 @@ fn cylindrical() -> f64 {
     2.0 * std::f64::consts::PI * R_V * R_V * HEIGHT * K
 }
 
-/// One run: the torque after every step against the rotation in mrad.
+/// One run: the torque after every step against the rotation in mrad
+/// (the run's `points`), with its number of points per element.
 struct Curve {
-    label: String,
+    run: Run,
     points_per_element: usize,
-    torque: Vec<(f64, f64)>,
-    elements: usize,
-    material_points: usize,
-    iterations: usize,
-    max_iterations: usize,
-    cuts: usize,
-    seconds: f64,
-    peak_mb: Option<f64>,
-    failure: Option<String>,
-    /// Per step: Newton iterations, seconds, iterative-solver iterations.
-    steps: Vec<(usize, f64, usize)>,
-    /// Stage times summed over the run.
-    times: mpm_solver::StageTimes,
-    free_dofs: usize,
+}
+
+impl std::ops::Deref for Curve {
+    type Target = Run;
+    fn deref(&self) -> &Run {
+        &self.run
+    }
 }
 
 fn run(mesh: &str, fpatch: bool, points: usize) -> Result<Curve> {
@@ -89,80 +78,28 @@ fn run_scene(spec: &Spec, mesh: &str, fpatch: bool, points: usize) -> Result<Cur
         11 => overrides.push("body.0.placement=\"keast11\"".to_owned()),
         n => anyhow::bail!("no tetrahedral rule with {n} points (1, 4 or 11)"),
     }
-    let (scene, src) = mpm_cases::scene::parse(spec.text, spec.file, &overrides)
-        .context("parsing the vane scene")?;
-    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
-    let problem =
-        Problem::<3>::build_in(&scene, &src, 0, &scenes).context("building the vane scene")?;
-    let vane = problem
-        .reactions
-        .iter()
-        .find(|r| r.name == "vane")
-        .cloned()
-        .context("the vane scene has no `vane` reaction")?;
-    let elements = match &problem.mesh {
-        mpm_cases::scene::build::SceneMesh::Simplex(m) => m.element_count(),
-        mpm_cases::scene::build::SceneMesh::Grid(_) => 0,
-    };
     let label = format!(
         "{}, {} point{}",
         if fpatch { "F-patch" } else { "standard MPM" },
         points,
         if points > 1 { "s" } else { "" }
     );
-    let mut curve = Curve {
-        label,
-        points_per_element: points,
-        torque: vec![(0.0, 0.0)],
-        elements,
-        material_points: problem.len(),
-        iterations: 0,
-        max_iterations: 0,
-        cuts: 0,
-        seconds: 0.0,
-        peak_mb: None,
-        failure: None,
-        steps: Vec::new(),
-        times: mpm_solver::StageTimes::default(),
-        free_dofs: 0,
-    };
     let rotation = spec.rotation;
-    let (result, seconds, peak): (Result<RunOutput<3>, _>, _, _) = measured(|| {
-        mpm_cases::scene::run(&problem, &RunControl::default(), |_, report, _| {
-            let m = vane.moment(&problem, report).map_or(f64::NAN, |m| m[2]);
-            curve.torque.push((1e3 * report.lambda1 * rotation, m));
-            curve.iterations += report.iterations();
-            curve.max_iterations = curve.max_iterations.max(report.iterations());
-            let t = &report.times;
-            curve
-                .steps
-                .push((report.iterations(), t.total(), report.linear_iterations));
-            let c = &mut curve.times;
-            c.basis += t.basis;
-            c.system += t.system;
-            c.material += t.material;
-            c.force += t.force;
-            c.tangent += t.tangent;
-            c.stiffness += t.stiffness;
-            c.solve += t.solve;
-            c.commit += t.commit;
-            curve.free_dofs = report.free_dofs;
-            Ok(())
-        })
-    });
-    (curve.seconds, curve.peak_mb) = (seconds, peak);
-    match result {
-        Ok(out) => curve.cuts = out.summary.cut_steps,
-        Err(e) => curve.failure = Some(e.to_string()),
-    }
-    print_run(
-        &format!("{}, {}", spec.name, curve.label),
-        curve.torque.len() - 1,
-        curve.iterations,
-        curve.seconds,
-        curve.failure.as_deref(),
-    );
-    Ok(curve)
+    let run = scene_run::run(
+        spec.text,
+        spec.file,
+        &overrides,
+        label,
+        "vane",
+        |problem, vane, report| {
+            let m = vane.moment(problem, report).map_or(f64::NAN, |m| m[2]);
+            (1e3 * report.lambda1 * rotation, m)
+        },
+    )?;
+    Ok(Curve {
+        run,
+        points_per_element: points,
+    })
 }
 
 /// The torque's slope over the last fifth of the rotation against the
@@ -232,7 +169,7 @@ pub fn section(full: bool, img: &Path) -> Result<String> {
         "late slope / initial slope",
     ]);
     let at = |c: &Curve, a: f64| {
-        c.torque
+        c.points
             .iter()
             .find(|p| (p.0 - a).abs() < 1e-9)
             .map_or("–".to_owned(), |p| format!("{:.3}", p.1))
@@ -244,18 +181,18 @@ pub fn section(full: bool, img: &Path) -> Result<String> {
             c.elements.to_string(),
             c.material_points.to_string(),
             match &c.failure {
-                None => format!("{} ({})", c.torque.len() - 1, c.cuts),
-                Some(f) => format!("{} (then failed: {f})", c.torque.len() - 1),
+                None => format!("{} ({})", c.points.len() - 1, c.cuts),
+                Some(f) => format!("{} (then failed: {f})", c.points.len() - 1),
             },
             format!("{} ({})", c.iterations, c.max_iterations),
             format!("{:.1}", c.seconds),
             c.peak_mb.map_or("–".to_owned(), |m| format!("{m:.0}")),
             at(c, 0.4),
             at(c, 0.8),
-            c.torque
+            c.points
                 .last()
                 .map_or("–".to_owned(), |p| format!("{:.3}", p.1 / t_cyl)),
-            late_slope(&c.torque).map_or("–".to_owned(), |s| format!("{s:.3}")),
+            late_slope(&c.points).map_or("–".to_owned(), |s| format!("{s:.3}")),
         ]);
     }
     md.push_str(&table.render());
@@ -282,7 +219,7 @@ pub fn section(full: bool, img: &Path) -> Result<String> {
 }
 
 fn reading(curves: &[Curve], t_cyl: f64) -> String {
-    let end = |c: &Curve| c.torque.last().map_or(f64::NAN, |p| p.1);
+    let end = |c: &Curve| c.points.last().map_or(f64::NAN, |p| p.1);
     let (standard, patched) = (&curves[0], &curves[1]);
     let mut text = String::from(
         "**Reading.** The paper's Fig. 18C: F-patch's torque plateaus after the soil yields, \
@@ -290,8 +227,8 @@ fn reading(curves: &[Curve], t_cyl: f64) -> String {
          element; F-patch's plateau differs from the cylindrical estimate. ",
     );
     match (
-        late_slope(&standard.torque).filter(|_| standard.failure.is_none()),
-        late_slope(&patched.torque).filter(|_| patched.failure.is_none()),
+        late_slope(&standard.points).filter(|_| standard.failure.is_none()),
+        late_slope(&patched.points).filter(|_| patched.failure.is_none()),
     ) {
         (Some(s), Some(f)) => {
             let _ = write!(
@@ -414,7 +351,7 @@ pub fn full_section(full: bool, img: &Path) -> Result<String> {
         "torque / cylindrical estimate",
     ]);
     let at = |c: &Curve, a: f64| {
-        c.torque
+        c.points
             .iter()
             .find(|p| (p.0 - a).abs() < 1e-9)
             .map_or("–".to_owned(), |p| format!("{:.2}", p.1))
@@ -428,8 +365,8 @@ pub fn full_section(full: bool, img: &Path) -> Result<String> {
             c.material_points.to_string(),
             c.free_dofs.to_string(),
             match &c.failure {
-                None => format!("{} ({})", c.torque.len() - 1, c.cuts),
-                Some(f) => format!("{} (then failed: {f})", c.torque.len() - 1),
+                None => format!("{} ({})", c.points.len() - 1, c.cuts),
+                Some(f) => format!("{} (then failed: {f})", c.points.len() - 1),
             },
             c.steps
                 .iter()
@@ -449,7 +386,7 @@ pub fn full_section(full: bool, img: &Path) -> Result<String> {
             }),
             at(c, 0.2),
             at(c, 0.4),
-            c.torque
+            c.points
                 .last()
                 .map_or("–".to_owned(), |p| format!("{:.3}", p.1 / t_cyl)),
         ]);
@@ -563,7 +500,7 @@ pub fn full_section(full: bool, img: &Path) -> Result<String> {
 }
 
 fn full_reading(curves: &[Curve], t_cyl: f64) -> String {
-    let end = |c: &Curve| c.torque.last().map_or(f64::NAN, |p| p.1);
+    let end = |c: &Curve| c.points.last().map_or(f64::NAN, |p| p.1);
     let (standard, patched) = (&curves[0], &curves[1]);
     let mut text = String::from(
         "\n**Reading.** The paper's Fig. 20C: F-patch appears to remove the locking; the full \
@@ -594,8 +531,8 @@ fn full_reading(curves: &[Curve], t_cyl: f64) -> String {
             end(standard),
             end(patched),
             end(patched) / t_cyl,
-            100.0 * last_increment(&patched.torque),
-            100.0 * last_increment(&standard.torque),
+            100.0 * last_increment(&patched.points),
+            100.0 * last_increment(&standard.points),
             patched
                 .steps
                 .iter()
@@ -639,7 +576,7 @@ fn torque_series(curves: &[Curve], estimate: &str, t_est: f64, rotation: f64) ->
         .enumerate()
         .map(|(i, c)| Series {
             label: c.label.clone(),
-            points: c.torque.clone(),
+            points: c.points.clone(),
             color: PALETTE[i],
             marker: Some(Marker::CYCLE[i]),
             filled: i == 0,
