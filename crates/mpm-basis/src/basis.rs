@@ -66,6 +66,37 @@ pub trait BasisFunction<const D: usize>: Send + Sync {
         self.evaluate(mesh, position, domain, out)
     }
 
+    /// Calls `visit(node, value, gradient)` for every supporting node of
+    /// the point at `position`, as [`evaluate`](Self::evaluate) would list
+    /// them. The default evaluates into `scratch` and walks it; bases with
+    /// a cheaper direct form (the tensor-product bases of this crate)
+    /// override it and leave `scratch` untouched, so a solver that only
+    /// streams over the nodes (the explicit point-to-grid and grid-to-point
+    /// stages) never stores a stencil.
+    ///
+    /// # Errors
+    /// As [`evaluate`](Self::evaluate); nothing is visited then.
+    #[inline]
+    fn for_each_node(
+        &self,
+        mesh: &Self::Mesh,
+        position: &SVector<f64, D>,
+        domain: &Self::Domain,
+        scratch: &mut Stencil<D>,
+        mut visit: impl FnMut(usize, f64, &SVector<f64, D>),
+    ) -> Result<(), BasisError> {
+        self.evaluate(mesh, position, domain, scratch)?;
+        for ((&node, &value), gradient) in scratch
+            .nodes
+            .iter()
+            .zip(&scratch.values)
+            .zip(&scratch.gradients)
+        {
+            visit(node, value, gradient);
+        }
+        Ok(())
+    }
+
     /// An empty stencil with room for [`BasisFunction::MAX_NODES`] nodes.
     fn new_stencil(&self) -> Stencil<D> {
         Stencil::with_capacity(Self::MAX_NODES)

@@ -4,7 +4,7 @@
 use mpm_mesh::RegularGrid;
 use nalgebra::SVector;
 
-use crate::tensor::{AxisFactors, tensor_product};
+use crate::tensor::{AxisFactors, tensor_product, visit_product};
 use crate::{BasisError, BasisFunction, Stencil};
 
 /// The standard material point method basis: $S_{vp} = N_v(\mathbf x_p)$,
@@ -45,13 +45,34 @@ impl<const D: usize> BasisFunction<D> for LinearMpm {
         out: &mut Stencil<D>,
     ) -> Result<(), BasisError> {
         out.clear();
-        let location = mesh.locate(position)?;
-        let mut axes = [AxisFactors::<2>::EMPTY; D];
-        for (i, axis) in axes.iter_mut().enumerate() {
-            let (k, t, h) = (location.cell[i], location.local[i], mesh.spacing()[i]);
-            axis.push(k, 1.0 - t, -1.0 / h);
-            axis.push(k + 1, t, 1.0 / h);
-        }
-        tensor_product(mesh, &axes, out)
+        tensor_product(mesh, &axis_factors(mesh, position)?, out)
     }
+
+    #[inline]
+    fn for_each_node(
+        &self,
+        mesh: &RegularGrid<D>,
+        position: &SVector<f64, D>,
+        _domain: &(),
+        _scratch: &mut Stencil<D>,
+        visit: impl FnMut(usize, f64, &SVector<f64, D>),
+    ) -> Result<(), BasisError> {
+        visit_product(mesh, &axis_factors(mesh, position)?, visit)
+    }
+}
+
+/// The two 1D hat factors per axis of the point at `position`.
+#[inline(always)]
+fn axis_factors<const D: usize>(
+    mesh: &RegularGrid<D>,
+    position: &SVector<f64, D>,
+) -> Result<[AxisFactors<2>; D], BasisError> {
+    let location = mesh.locate(position)?;
+    let mut axes = [AxisFactors::<2>::EMPTY; D];
+    for (i, axis) in axes.iter_mut().enumerate() {
+        let (k, t, h) = (location.cell[i], location.local[i], mesh.spacing()[i]);
+        axis.push(k, 1.0 - t, -1.0 / h);
+        axis.push(k + 1, t, 1.0 / h);
+    }
+    Ok(axes)
 }

@@ -3,7 +3,7 @@
 use mpm_mesh::RegularGrid;
 use nalgebra::SVector;
 
-use crate::tensor::{AxisFactors, tensor_product};
+use crate::tensor::{AxisFactors, tensor_product, visit_product};
 use crate::{BasisError, BasisFunction, Stencil};
 
 /// Uniform quadratic B-spline basis (Steffen et al. 2008; MPoint theory
@@ -70,6 +70,31 @@ impl<const D: usize> BasisFunction<D> for QuadraticBSpline {
         out: &mut Stencil<D>,
     ) -> Result<(), BasisError> {
         out.clear();
+        let axes = Self::axis_factors(mesh, position)?;
+        tensor_product(mesh, &axes, out)
+    }
+
+    #[inline]
+    fn for_each_node(
+        &self,
+        mesh: &RegularGrid<D>,
+        position: &SVector<f64, D>,
+        _domain: &(),
+        _scratch: &mut Stencil<D>,
+        visit: impl FnMut(usize, f64, &SVector<f64, D>),
+    ) -> Result<(), BasisError> {
+        let axes = Self::axis_factors(mesh, position)?;
+        visit_product(mesh, &axes, visit)
+    }
+}
+
+impl QuadraticBSpline {
+    /// The three 1D factors per axis of the point at `position`.
+    #[inline(always)]
+    fn axis_factors<const D: usize>(
+        mesh: &RegularGrid<D>,
+        position: &SVector<f64, D>,
+    ) -> Result<[AxisFactors<3>; D], BasisError> {
         let location = mesh.locate(position)?;
         let cells = mesh.cells_per_axis();
         let mut axes = [AxisFactors::<3>::EMPTY; D];
@@ -78,23 +103,32 @@ impl<const D: usize> BasisFunction<D> for QuadraticBSpline {
             // Nodes k-1..=k+1 when t < 1/2, k..=k+2 otherwise; node j sits at
             // r = t + k - j. A node at exactly |r| = 3/2 has a zero factor and
             // zero slope and is skipped, so the admissible region is closed.
-            let first = if t < 0.5 { k as isize - 1 } else { k as isize };
-            for node in first..first + 3 {
-                let r = t + (k as isize - node) as f64;
-                let (n, dn) = Self::shape_1d(r);
+            // With fx = r of the first node in [0.5, 1.5): the three
+            // factors of eqs. (24)-(25) without branches (the quadratic
+            // pieces at r = fx, fx - 1, fx - 2).
+            let (first, fx) = if t < 0.5 {
+                (k.wrapping_sub(1), t + 1.0)
+            } else {
+                (k, t)
+            };
+            let (a, b, c) = (1.5 - fx, fx - 1.0, fx - 0.5);
+            let values = [0.5 * a * a, 0.75 - b * b, 0.5 * c * c];
+            let slopes = [-a, -2.0 * b, c];
+            for (offset, (n, dn)) in values.into_iter().zip(slopes).enumerate() {
                 if n == 0.0 && dn == 0.0 {
                     continue;
                 }
-                let Some(node) = usize::try_from(node).ok().filter(|&j| j <= cells[i]) else {
+                let node = first.wrapping_add(offset);
+                if node > cells[i] {
                     return Err(BasisError::StencilOutsideGrid {
                         point: position.iter().copied().collect(),
                         axis: i,
                     });
-                };
+                }
                 axis.push(node, n, dn / h);
             }
         }
-        tensor_product(mesh, &axes, out)
+        Ok(axes)
     }
 }
 

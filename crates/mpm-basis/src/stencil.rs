@@ -52,6 +52,7 @@ impl<const D: usize> Stencil<D> {
     }
 
     /// Remove all entries, keeping the capacity.
+    #[inline]
     pub fn clear(&mut self) {
         self.nodes.clear();
         self.values.clear();
@@ -59,6 +60,7 @@ impl<const D: usize> Stencil<D> {
     }
 
     /// Append an entry (the caller keeps node ids unique).
+    #[inline]
     pub fn push(&mut self, node: usize, value: f64, gradient: SVector<f64, D>) {
         self.nodes.push(node);
         self.values.push(value);

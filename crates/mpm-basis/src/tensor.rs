@@ -53,28 +53,114 @@ pub(crate) fn tensor_product<const D: usize, const K: usize>(
     out: &mut Stencil<D>,
 ) -> Result<(), BasisError> {
     out.clear();
+    visit_product(grid, axes, |id, value, gradient| {
+        out.push(id, value, *gradient)
+    })
+}
+
+/// Calls `visit(node, value, gradient)` for every product of the per-axis
+/// factors whose value or gradient is non-zero, the first axis running
+/// fastest (the order of a lexicographic loop).
+///
+/// The node indices are checked once per axis and turned into id offsets,
+/// so the loops do no bounds checking, no division and no allocation.
+// The loops index several parallel arrays (values, slopes, offsets) by
+// the same factor number.
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+pub(crate) fn visit_product<const D: usize, const K: usize>(
+    grid: &RegularGrid<D>,
+    axes: &[AxisFactors<K>; D],
+    mut visit: impl FnMut(usize, f64, &SVector<f64, D>),
+) -> Result<(), BasisError> {
     if axes.iter().any(|a| a.len == 0) {
         return Ok(());
     }
+    let nodes = grid.nodes_per_axis();
+    let strides = grid.node_strides();
+    let mut offset = [[0usize; K]; D];
+    for i in 0..D {
+        for c in 0..axes[i].len {
+            let j = axes[i].index[c];
+            if j >= nodes[i] {
+                let mut index = [0; D];
+                index[i] = j;
+                // Produces the grid's own out-of-range error.
+                grid.node_id(index)?;
+            }
+            offset[i][c] = j * strides[i];
+        }
+    }
+    // Nested loops for the planar and spatial cases (the first axis
+    // innermost), with the products associated as in the counter loop so
+    // that every path gives the same bits.
+    let mut emit = |id: usize, value: f64, gradient: SVector<f64, D>| {
+        if value != 0.0 || gradient.iter().any(|&g| g != 0.0) {
+            visit(id, value, &gradient);
+        }
+    };
+    if D == 3 {
+        let (a0, a1, a2) = (&axes[0], &axes[1], &axes[2]);
+        for c in 0..a2.len {
+            let (v2, s2, o2) = (a2.value[c], a2.slope[c], offset[2][c]);
+            for b in 0..a1.len {
+                let (v1, s1, o1) = (a1.value[b], a1.slope[b], offset[1][b] + o2);
+                for a in 0..a0.len {
+                    let (v0, s0) = (a0.value[a], a0.slope[a]);
+                    let p01 = v0 * v1;
+                    let mut g = SVector::<f64, D>::zeros();
+                    g[0] = s0 * v1 * v2;
+                    g[1] = v0 * s1 * v2;
+                    g[2] = p01 * s2;
+                    emit(offset[0][a] + o1, p01 * v2, g);
+                }
+            }
+        }
+        Ok(())
+    } else if D == 2 {
+        let (a0, a1) = (&axes[0], &axes[1]);
+        for b in 0..a1.len {
+            let (v1, s1, o1) = (a1.value[b], a1.slope[b], offset[1][b]);
+            for a in 0..a0.len {
+                let (v0, s0) = (a0.value[a], a0.slope[a]);
+                let mut g = SVector::<f64, D>::zeros();
+                g[0] = s0 * v1;
+                g[1] = v0 * s1;
+                emit(offset[0][a] + o1, v0 * v1, g);
+            }
+        }
+        Ok(())
+    } else {
+        visit_product_counter(axes, &offset, visit)
+    }
+}
+
+/// The same product by a counter loop, for any dimension.
+fn visit_product_counter<const D: usize, const K: usize>(
+    axes: &[AxisFactors<K>; D],
+    offset: &[[usize; K]; D],
+    mut visit: impl FnMut(usize, f64, &SVector<f64, D>),
+) -> Result<(), BasisError> {
     let mut counter = [0usize; D];
     loop {
+        let mut id = 0;
         let mut value = 1.0;
-        let mut index = [0usize; D];
         for i in 0..D {
+            id += offset[i][counter[i]];
             value *= axes[i].value[counter[i]];
-            index[i] = axes[i].index[counter[i]];
         }
-        let gradient = SVector::<f64, D>::from_fn(|j, _| {
-            (0..D).fold(1.0, |g, i| {
-                g * if i == j {
-                    axes[i].slope[counter[i]]
-                } else {
-                    axes[i].value[counter[i]]
+        let mut gradient = SVector::<f64, D>::zeros();
+        for j in 0..D {
+            let mut g = axes[j].slope[counter[j]];
+            for i in 0..D {
+                if i != j {
+                    g *= axes[i].value[counter[i]];
                 }
-            })
-        });
+            }
+            gradient[j] = g;
+        }
         if value != 0.0 || gradient.iter().any(|&g| g != 0.0) {
-            out.push(grid.node_id(index)?, value, gradient);
+            visit(id, value, &gradient);
         }
         let mut axis = 0;
         loop {

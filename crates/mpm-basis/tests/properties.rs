@@ -1,7 +1,8 @@
 //! Property tests run for every basis in 2D and 3D by one macro: partition
 //! of unity, zero gradient sum, linear reproduction, gradients against
-//! finite differences, well-formed stencils (no node outside the grid), and
-//! hinted evaluation agreeing with the plain one.
+//! finite differences, well-formed stencils (no node outside the grid),
+//! hinted evaluation agreeing with the plain one, and the streaming
+//! `for_each_node` visiting exactly the evaluated stencil.
 #![allow(missing_docs)]
 
 mod common;
@@ -44,6 +45,11 @@ macro_rules! basis_properties {
                 #[test]
                 fn stencil_is_well_formed_and_inside_the_grid((x, domain) in $cases) {
                     check_well_formed::<$dim, _>(&$basis, &x, &domain)?;
+                }
+
+                #[test]
+                fn visiting_matches_evaluation((x, domain) in $cases) {
+                    check_visited::<$dim, _>(&$basis, &x, &domain)?;
                 }
 
                 #[test]

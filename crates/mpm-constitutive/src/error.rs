@@ -67,6 +67,20 @@ pub enum ConstitutiveError {
         /// The number of laws given.
         count: usize,
     },
+    /// An explicit solver needs the law's elastic wave speed (MPoint notes
+    /// eq. 46) and the law does not define isotropic elastic constants.
+    #[error("the law defines no elastic constants; give its P-wave modulus K + 4G/3 explicitly")]
+    NoElasticConstants,
+    /// The P-wave modulus must be positive and finite.
+    #[error("P-wave modulus {value} must be positive and finite")]
+    InvalidWaveModulus {
+        /// The value given.
+        value: f64,
+    },
+    /// An energy balance asked for the stored energy of a law that does
+    /// not define it.
+    #[error("the law does not define a stored energy")]
+    NoStoredEnergy,
 }
 
 /// Shorthand for results of this crate.

@@ -1,6 +1,6 @@
 //! Hencky (logarithmic-strain) hyperelasticity.
 
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 
 use crate::error::Result;
 use crate::law::{IsotropicElasticity, LawState, LogStrainLaw};
@@ -48,6 +48,14 @@ impl LogStrainLaw for HenckyElastic {
     #[inline]
     fn algorithmic_tangent(&self, _trial: &SymSpectral, _h: &(), _s: &LawState<()>) -> Tensor4 {
         self.elasticity.stiffness()
+    }
+
+    fn elasticity(&self) -> Option<IsotropicElasticity> {
+        Some(self.elasticity)
+    }
+
+    fn stored_energy(&self, elastic_strain: &Vector3<f64>, _history: &()) -> Option<f64> {
+        Some(self.elasticity.energy(elastic_strain))
     }
 }
 

@@ -61,6 +61,22 @@ pub trait LogStrainLaw: Send + Sync {
         state: &LawState<Self::History>,
     ) -> Tensor4;
 
+    /// The law's small-strain elastic constants, when it has isotropic
+    /// ones: explicit solvers take the wave speed of eq. (46) of the MPoint
+    /// notes from them. `None` by default.
+    fn elasticity(&self) -> Option<IsotropicElasticity> {
+        None
+    }
+
+    /// The stored (recoverable) energy per unit reference volume of the
+    /// elastic Hencky strain with principal values `elastic_strain`, for
+    /// energy balances; plastic dissipation is not included. `None` when
+    /// the law does not define it (the default).
+    fn stored_energy(&self, elastic_strain: &Vector3<f64>, history: &Self::History) -> Option<f64> {
+        let _ = (elastic_strain, history);
+        None
+    }
+
     /// Convenience for tests and callers holding a plain tensor: the return
     /// map of the symmetric trial strain `eps`, with the Kirchhoff stress as
     /// a tensor.
@@ -125,6 +141,23 @@ impl IsotropicElasticity {
     pub fn principal_stress(&self, eps: &Vector3<f64>) -> Vector3<f64> {
         let tr = eps.sum();
         eps.map(|e| self.lambda * tr + 2.0 * self.mu * e)
+    }
+
+    /// The quadratic strain energy $\psi = \tfrac\lambda2(\sum_a\varepsilon_a)^2 +
+    /// \mu\sum_a\varepsilon_a^2$ of principal strains `eps`, whose
+    /// derivative is [`Self::principal_stress`].
+    #[inline]
+    pub fn energy(&self, eps: &Vector3<f64>) -> f64 {
+        let tr = eps.sum();
+        0.5 * self.lambda * tr * tr + self.mu * eps.norm_squared()
+    }
+
+    /// The P-wave modulus $K + \tfrac43 G = \lambda + 2\mu$ (MPoint notes
+    /// eq. 46 with the bulk modulus $K = E/(3(1-2\nu))$; the notes print
+    /// $E/(3(1+\nu))$, a misprint).
+    #[inline]
+    pub fn p_wave_modulus(&self) -> f64 {
+        self.bulk + 4.0 / 3.0 * self.mu
     }
 
     /// The elastic stiffness $D^e = \lambda\,\mathbf 1\otimes\mathbf 1 + 2\mu\,\mathbb I^s$.

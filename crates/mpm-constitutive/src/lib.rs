@@ -42,6 +42,7 @@
 pub mod driver;
 pub mod error;
 pub mod hencky;
+pub mod incremental;
 pub mod kinematics;
 pub mod law;
 pub mod material_set;
@@ -57,6 +58,7 @@ pub use driver::{
 };
 pub use error::{ConstitutiveError, Result};
 pub use hencky::HenckyElastic;
+pub use incremental::{IncrementalLaw, Spectral};
 pub use law::{IsotropicElasticity, LawState, LogStrainLaw};
 pub use material_set::{MaterialSet, Tagged};
 pub use neo_hookean::NeoHookean;

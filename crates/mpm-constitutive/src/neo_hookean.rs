@@ -35,7 +35,7 @@ use crate::error::Result;
 use crate::law::{IsotropicElasticity, LawState, LogStrainLaw};
 use crate::spectral::SymSpectral;
 use crate::tensor::{Tensor4, dyad};
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 
 /// Compressible Neo-Hookean elasticity,
 /// $\tau = \mu(b - \mathbf 1) + \lambda\ln J\,\mathbf 1$ (see the module
@@ -113,6 +113,14 @@ impl LogStrainLaw for NeoHookean {
         let (lambda, mu) = (self.elasticity.lambda, self.elasticity.mu);
         let one = Matrix3::identity();
         lambda * dyad(&one, &one) + trial.derivative(|a, b| 2.0 * mu * (a + b).exp() * sinhc(a - b))
+    }
+
+    fn elasticity(&self) -> Option<IsotropicElasticity> {
+        Some(self.elasticity)
+    }
+
+    fn stored_energy(&self, elastic_strain: &Vector3<f64>, _history: &()) -> Option<f64> {
+        Some(self.energy(&[elastic_strain[0], elastic_strain[1], elastic_strain[2]]))
     }
 }
 

@@ -173,4 +173,17 @@ impl LogStrainLaw for VonMises {
         let dev = sym_identity() - one_one / 3.0;
         el.bulk * one_one + two_mu * theta * dev - two_mu * theta_bar * dyad(&n, &n)
     }
+
+    fn elasticity(&self) -> Option<IsotropicElasticity> {
+        Some(self.elasticity)
+    }
+
+    /// The elastic part only; plastic work is dissipated.
+    fn stored_energy(
+        &self,
+        elastic_strain: &Vector3<f64>,
+        _history: &VonMisesHistory,
+    ) -> Option<f64> {
+        Some(self.elasticity.energy(elastic_strain))
+    }
 }

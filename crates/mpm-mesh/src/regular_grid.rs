@@ -191,6 +191,12 @@ impl<const D: usize> RegularGrid<D> {
         self.cells.map(|n| n + 1)
     }
 
+    /// Node id strides per axis: node `[i, j, ..]` has id
+    /// `i * strides[0] + j * strides[1] + ..` (the first axis is fastest).
+    pub fn node_strides(&self) -> [usize; D] {
+        self.node_strides
+    }
+
     /// Total number of nodes.
     pub fn node_count(&self) -> usize {
         self.node_count
@@ -335,6 +341,7 @@ impl<const D: usize> RegularGrid<D> {
     /// # Errors
     /// [`MeshError::PointOutsideGrid`] as for
     /// [`RegularGrid::cell_containing`].
+    #[inline]
     pub fn locate(&self, point: &SVector<f64, D>) -> Result<CellLocation<D>, MeshError> {
         if !self.contains(point) {
             return Err(self.outside(point));
@@ -342,10 +349,11 @@ impl<const D: usize> RegularGrid<D> {
         let mut cell = [0; D];
         let mut local = SVector::<f64, D>::zeros();
         for axis in 0..D {
-            // `contains` guarantees 0 <= r <= n (up to one rounding), so the
-            // conversion is exact and the clamp only acts on the upper face.
+            // `contains` guarantees point >= origin, so r >= 0 and the
+            // truncating conversion is the floor (without a libm call); r <= n
+            // up to one rounding, so the clamp only acts on the upper face.
             let r = (point[axis] - self.origin[axis]) / self.spacing[axis];
-            let k = (r.floor() as usize).min(self.cells[axis] - 1);
+            let k = (r as usize).min(self.cells[axis] - 1);
             cell[axis] = k;
             local[axis] = (r - k as f64).clamp(0.0, 1.0);
         }

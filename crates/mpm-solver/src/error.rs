@@ -113,6 +113,19 @@ pub enum SolverError {
         /// Load factor reached.
         load_factor: f64,
     },
+    /// A material point could not be advanced by an explicit time step.
+    #[error("explicit step {step} at t = {time:e}: material point {point}: {reason}")]
+    ExplicitPoint {
+        /// The step (counting from 1) that failed.
+        step: usize,
+        /// The time at the start of that step.
+        time: f64,
+        /// Index of the material point.
+        point: usize,
+        /// What went wrong.
+        #[source]
+        reason: PointFailure,
+    },
     /// Inconsistent problem set-up.
     #[error("invalid input: {0}")]
     InvalidInput(String),
@@ -248,4 +261,34 @@ impl PartialEq for ObserverError {
     fn eq(&self, other: &Self) -> bool {
         Arc::ptr_eq(&self.0, &other.0) || self.0.to_string() == other.0.to_string()
     }
+}
+
+/// Why the explicit solver could not advance a material point.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PointFailure {
+    /// The basis could not be evaluated at the point: it left the grid (or
+    /// came closer to its boundary than the basis allows).
+    #[error("at {position:?}: {source}")]
+    Basis {
+        /// The point's position.
+        position: Vec<f64>,
+        /// The basis error.
+        #[source]
+        source: BasisFailure,
+    },
+    /// The stress update failed.
+    #[error(transparent)]
+    Constitutive(#[from] ConstitutiveError),
+    /// The deformation gradient lost its positive determinant.
+    #[error("det F = {det:e} <= 0: the motion inverts the point")]
+    Inverted {
+        /// $\det F$ after the step.
+        det: f64,
+    },
+    /// The velocity became non-finite.
+    #[error("the velocity became non-finite ({velocity:?})")]
+    NonFinite {
+        /// The velocity.
+        velocity: Vec<f64>,
+    },
 }

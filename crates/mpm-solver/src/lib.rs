@@ -67,6 +67,7 @@ pub mod boundary;
 pub mod checkpoint;
 pub mod domain;
 pub mod error;
+pub mod explicit;
 pub mod formulation;
 pub mod implicit;
 pub mod linear;
@@ -86,7 +87,12 @@ pub use domain::{
     IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, StretchU, VolumeCorrectedDiagF,
 };
 pub use error::{
-    BasisFailure, LockingError, MeshMotionError, ObserverError, SolverError, StepFailure,
+    BasisFailure, LockingError, MeshMotionError, ObserverError, PointFailure, SolverError,
+    StepFailure,
+};
+pub use explicit::{
+    CellAveraged, ExplicitOptions, ExplicitPoints, ExplicitSolver, Flip, FlipPic, Pic, Taylor,
+    TimeStep, Transfer, VelocityFixities,
 };
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
 pub use implicit::{

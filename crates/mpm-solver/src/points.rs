@@ -72,24 +72,7 @@ impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
                 domain.len()
             )));
         }
-        if let Some((p, v)) = volume
-            .iter()
-            .enumerate()
-            .find(|(_, v)| !(v.is_finite() && **v > 0.0))
-        {
-            return Err(SolverError::InvalidInput(format!(
-                "material point {p} has volume {v}; volumes must be positive and finite"
-            )));
-        }
-        if let Some(p) = position
-            .iter()
-            .position(|x| x.iter().any(|c| !c.is_finite()))
-        {
-            return Err(SolverError::InvalidInput(format!(
-                "material point {p} has a non-finite position {:?}",
-                position[p].as_slice()
-            )));
-        }
+        check_points(&position, &volume)?;
         if !(density.is_finite() && density >= 0.0) {
             return Err(SolverError::InvalidInput(format!(
                 "density {density} must be non-negative and finite"
@@ -128,4 +111,31 @@ impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
     pub fn set_gravity(&mut self, g: SVector<f64, D>) {
         self.body_force = self.mass.iter().map(|m| g * *m).collect();
     }
+}
+
+/// Checks that every volume is positive and finite and every position
+/// finite (shared by the implicit and explicit point sets).
+pub(crate) fn check_points<const D: usize>(
+    position: &[SVector<f64, D>],
+    volume: &[f64],
+) -> Result<(), SolverError> {
+    if let Some((p, v)) = volume
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+    {
+        return Err(SolverError::InvalidInput(format!(
+            "material point {p} has volume {v}; volumes must be positive and finite"
+        )));
+    }
+    if let Some(p) = position
+        .iter()
+        .position(|x| x.iter().any(|c| !c.is_finite()))
+    {
+        return Err(SolverError::InvalidInput(format!(
+            "material point {p} has a non-finite position {:?}",
+            position[p].as_slice()
+        )));
+    }
+    Ok(())
 }

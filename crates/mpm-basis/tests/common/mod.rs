@@ -583,3 +583,30 @@ where
     prop_assert_eq!(again, hinted);
     Ok(())
 }
+
+/// `for_each_node` visits exactly the stencil of `evaluate`, in the same
+/// order, with bit-identical values and gradients (bases that override it
+/// must not change a result).
+pub fn check_visited<const D: usize, B>(
+    basis: &B,
+    x: &SVector<f64, D>,
+    domain: &B::Domain,
+) -> Result<(), TestCaseError>
+where
+    B: BasisFunction<D>,
+    B::Mesh: TestMesh<D>,
+{
+    let mesh = B::Mesh::test_mesh();
+    let plain = evaluate(basis, x, domain)?;
+    let mut visited = Stencil::<D>::with_capacity(B::MAX_NODES);
+    let mut scratch = Stencil::for_basis::<B>();
+    basis
+        .for_each_node(mesh, x, domain, &mut scratch, |i, w, g| {
+            visited.push(i, w, *g)
+        })
+        .map_err(|e| TestCaseError::fail(format!("visiting failed at {x:?}: {e}")))?;
+    prop_assert_eq!(&plain.nodes, &visited.nodes);
+    prop_assert_eq!(&plain.values, &visited.values);
+    prop_assert_eq!(&plain.gradients, &visited.gradients);
+    Ok(())
+}

@@ -1,0 +1,59 @@
+//! Energies of an explicit run.
+
+use mpm_constitutive::IncrementalLaw;
+use nalgebra::SVector;
+
+use super::points::ExplicitPoints;
+use crate::error::{PointFailure, SolverError};
+
+/// The energies of the points at one instant.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Energies {
+    /// $\sum_p \tfrac12 m_p\|v_p\|^2$.
+    pub kinetic: f64,
+    /// $\sum_p V^0_p\,\psi_p$, the law's stored energy.
+    pub strain: f64,
+    /// $-\sum_p m_p\,b\cdot x_p$ (zero at the origin).
+    pub gravitational: f64,
+    /// Work of the applied point forces since the start.
+    pub external_work: f64,
+}
+
+impl Energies {
+    /// Kinetic + strain + gravitational − external work: constant for a
+    /// conservative scheme.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.strain + self.gravitational - self.external_work
+    }
+}
+
+/// The energies of `points` under `law` and gravity `gravity`.
+///
+/// # Errors
+/// The law defines no stored energy for a point's state.
+pub fn energies<const D: usize, L: IncrementalLaw, T>(
+    law: &L,
+    gravity: &SVector<f64, D>,
+    points: &ExplicitPoints<D, L::State, T>,
+    external_work: f64,
+) -> Result<Energies, SolverError> {
+    let mut e = Energies {
+        external_work,
+        ..Energies::default()
+    };
+    for p in 0..points.len() {
+        let m = points.mass[p];
+        e.kinetic += 0.5 * m * points.velocity[p].norm_squared();
+        e.gravitational -= m * gravity.dot(&points.position[p]);
+        e.strain += points.volume0[p]
+            * law.stored_energy(&points.material[p]).map_err(|source| {
+                SolverError::ExplicitPoint {
+                    step: 0,
+                    time: 0.0,
+                    point: p,
+                    reason: PointFailure::Constitutive(source),
+                }
+            })?;
+    }
+    Ok(e)
+}

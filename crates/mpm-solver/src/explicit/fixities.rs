@@ -1,0 +1,78 @@
+//! Prescribed nodal velocities (MPoint notes, below eq. 32).
+
+/// Nodal velocity fixities: after the grid update (eq. 32) the listed
+/// components are set, $\tilde v_i^{n+1} = v^{fix}_i$, and their
+/// acceleration recomputed as $(\tilde v_i^{n+1} - v_i^n)/\Delta t$. A slip
+/// wall fixes the normal component to zero; a clamp fixes all.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct VelocityFixities {
+    /// (node, component, velocity), sorted and without duplicates after
+    /// [`VelocityFixities::finish`].
+    entries: Vec<(usize, usize, f64)>,
+}
+
+impl VelocityFixities {
+    /// No fixities.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Fixes component `component` of `nodes` at zero velocity.
+    pub fn fix(&mut self, nodes: impl IntoIterator<Item = usize>, component: usize) -> &mut Self {
+        self.prescribe(nodes, component, 0.0)
+    }
+
+    /// Prescribes component `component` of `nodes` to `velocity`; a later
+    /// call on the same component replaces the value.
+    pub fn prescribe(
+        &mut self,
+        nodes: impl IntoIterator<Item = usize>,
+        component: usize,
+        velocity: f64,
+    ) -> &mut Self {
+        self.entries
+            .extend(nodes.into_iter().map(|n| (n, component, velocity)));
+        self.finish();
+        self
+    }
+
+    fn finish(&mut self) {
+        // Stable sort keeps the last value of a repeated component last.
+        self.entries.sort_by_key(|&(n, c, _)| (n, c));
+        let mut out: Vec<(usize, usize, f64)> = Vec::with_capacity(self.entries.len());
+        for e in self.entries.drain(..) {
+            match out.last_mut() {
+                Some(last) if (last.0, last.1) == (e.0, e.1) => *last = e,
+                _ => out.push(e),
+            }
+        }
+        self.entries = out;
+    }
+
+    /// The fixed components, sorted by node.
+    pub fn entries(&self) -> &[(usize, usize, f64)] {
+        &self.entries
+    }
+
+    /// Number of fixed components.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Whether nothing is fixed.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn later_values_replace_earlier_ones() {
+        let mut f = VelocityFixities::new();
+        f.fix([3, 1], 0).prescribe([3], 0, 2.0).fix([3], 1);
+        assert_eq!(f.entries(), &[(1, 0, 0.0), (3, 0, 2.0), (3, 1, 0.0)]);
+    }
+}

@@ -1,0 +1,166 @@
+//! Stage 3, grid to point: velocity (eq. 36), position (eq. 37, corrected),
+//! velocity gradient (eq. 38), deformation gradient (eq. 39), volume and
+//! density (eqs. 40–41) and the stress update.
+
+use mpm_constitutive::IncrementalLaw;
+use nalgebra::{Matrix3, SMatrix, SVector};
+
+use super::grid_update::GridState;
+use crate::error::PointFailure;
+
+/// The grid fields interpolated at a point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gathered<const D: usize> {
+    /// $\sum_i w_{ip}\tilde v^{n+1}_i$.
+    pub new_velocity: SVector<f64, D>,
+    /// $\sum_i w_{ip}v^n_i$.
+    pub old_velocity: SVector<f64, D>,
+    /// $\nabla v_p = \sum_i \tilde v^{n+1}_i\otimes\nabla w_{ip}$ (eq. 38).
+    pub grad: SMatrix<f64, D, D>,
+}
+
+/// Adds the contribution of node `i` with weight `w` and weight gradient
+/// `dw` to the interpolated fields.
+#[inline(always)]
+pub fn gather_node<const D: usize>(
+    g: &mut Gathered<D>,
+    grid: &GridState<D>,
+    i: usize,
+    w: f64,
+    dw: &SVector<f64, D>,
+) {
+    let node = &grid.velocity[i];
+    g.new_velocity += node.new * w;
+    g.old_velocity += node.old * w;
+    g.grad += node.new * dw.transpose();
+}
+
+impl<const D: usize> Default for Gathered<D> {
+    fn default() -> Self {
+        Self {
+            new_velocity: SVector::zeros(),
+            old_velocity: SVector::zeros(),
+            grad: SMatrix::zeros(),
+        }
+    }
+}
+
+/// The point's new velocity by the blend of eq. (36) and its new position
+/// by the second-order update of Nairn & Hammerquist (2021),
+/// $$x^{n+1}_p = x^n_p + \Delta t\sum_i w_{ip}\tilde v^{n+1}_i - \tfrac12\Delta t^2\sum_i w_{ip}a^n_i
+/// = x^n_p + \tfrac{\Delta t}2\sum_i w_{ip}\left(v^n_i + \tilde v^{n+1}_i\right).$$
+/// The notes print eq. (37) with $+\Delta t^2$ in place of
+/// $-\tfrac12\Delta t^2$, a misprint: under a uniform acceleration $a$ the
+/// printed form moves a point by $v\Delta t + 2a\Delta t^2$ instead of the
+/// exact $v\Delta t + \tfrac12 a\Delta t^2$ (the free-fall test of
+/// `tests/explicit.rs` pins this).
+#[inline(always)]
+pub fn move_point<const D: usize>(
+    alpha: f64,
+    dt: f64,
+    g: &Gathered<D>,
+    x: &mut SVector<f64, D>,
+    v: &mut SVector<f64, D>,
+) {
+    *x += (g.new_velocity + g.old_velocity) * (0.5 * dt);
+    *v = super::transfer::blend_velocity(alpha, v, &g.new_velocity, &g.old_velocity);
+}
+
+/// $\mathbf 1 + \Delta t\,\nabla v$ embedded in 3×3 (plane strain: the
+/// out-of-plane stretch stays 1).
+#[inline(always)]
+pub fn increment<const D: usize>(dt: f64, grad: &SMatrix<f64, D, D>) -> Matrix3<f64> {
+    let mut df = Matrix3::identity();
+    for a in 0..D {
+        for b in 0..D {
+            df[(a, b)] += dt * grad[(a, b)];
+        }
+    }
+    df
+}
+
+/// Eqs. (39)–(41) and the stress: $F \leftarrow (\mathbf 1 + \Delta t\nabla v)F$,
+/// $V = \det(F)V^0$ from the unmodified gradient `grad`; the law advances
+/// with $\mathbf 1 + \Delta t\,\overline{\nabla v}$ from `grad_bar` (equal
+/// to `grad` without a locking treatment) and returns the Kirchhoff stress.
+///
+/// # Errors
+/// $\det F \le 0$ or a failed stress update; the point is left unchanged.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn deform<const D: usize, L: IncrementalLaw>(
+    law: &L,
+    dt: f64,
+    grad: &SMatrix<f64, D, D>,
+    grad_bar: Option<&SMatrix<f64, D, D>>,
+    f: &mut Matrix3<f64>,
+    volume: &mut f64,
+    volume0: f64,
+    tau: &mut Matrix3<f64>,
+    state: &mut L::State,
+) -> Result<(), PointFailure> {
+    let df = increment(dt, grad);
+    let f_new = df * *f;
+    let j = f_new.determinant();
+    if j.is_nan() || j <= 0.0 {
+        return Err(PointFailure::Inverted { det: j });
+    }
+    let df_bar = match grad_bar {
+        Some(g) => increment(dt, g),
+        None => df,
+    };
+    *tau = law.update(&df_bar, state)?;
+    *f = f_new;
+    *volume = j * volume0;
+    Ok(())
+}
+
+/// $c_p + \|v_p\|$ of eq. (45) with $c_p = \sqrt{M/\rho_p}$, $\rho_p = m_p/V_p$
+/// (eqs. 41, 46) and the P-wave modulus $M = K + \tfrac43G$.
+#[inline(always)]
+pub fn signal_speed<const D: usize>(
+    p_wave_modulus: f64,
+    mass: f64,
+    volume: f64,
+    v: &SVector<f64, D>,
+) -> f64 {
+    (p_wave_modulus * volume / mass).sqrt() + v.norm()
+}
+
+/// The end of a point's update, shared by the fused and the averaged
+/// stage: [`deform`] with the unmodified gradient `grad` and the law's
+/// gradient `grad_bar`, the transfer state, and the point's $c_p + \|v_p\|$.
+///
+/// # Errors
+/// As [`deform`], and a non-finite velocity.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn finish<const D: usize, L: IncrementalLaw, T: super::Transfer<D>>(
+    law: &L,
+    p_wave_modulus: f64,
+    dt: f64,
+    grad: &SMatrix<f64, D, D>,
+    grad_bar: Option<&SMatrix<f64, D, D>>,
+    point: super::PointMut<'_, D, L::State, T::PointState>,
+) -> Result<f64, PointFailure> {
+    deform(
+        law,
+        dt,
+        grad,
+        grad_bar,
+        point.f,
+        point.volume,
+        point.volume0,
+        point.tau,
+        point.material,
+    )?;
+    *point.transfer = T::next_state(grad);
+    let s = signal_speed(p_wave_modulus, point.mass, *point.volume, point.velocity);
+    if s.is_finite() {
+        Ok(s)
+    } else {
+        Err(PointFailure::NonFinite {
+            velocity: point.velocity.iter().copied().collect(),
+        })
+    }
+}

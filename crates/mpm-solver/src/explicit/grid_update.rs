@@ -1,0 +1,122 @@
+//! Stage 2, the grid update: nodal velocity (eq. 30), acceleration (eq.
+//! 31), updated velocity (eq. 32) and the velocity fixities.
+
+use nalgebra::SVector;
+use rayon::prelude::*;
+
+use super::fixities::VelocityFixities;
+use super::p2g::{GridBuffer, NodeSums};
+
+/// Nodes per parallel task of the grid update.
+const NODES_PER_TASK: usize = 4096;
+
+/// The velocities of one node, stored together (one cache line per node
+/// read by the grid-to-point stage).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodeVelocity<const D: usize> {
+    /// $v^n_i$.
+    pub old: SVector<f64, D>,
+    /// $\tilde v^{n+1}_i$.
+    pub new: SVector<f64, D>,
+}
+
+impl<const D: usize> Default for NodeVelocity<D> {
+    fn default() -> Self {
+        Self {
+            old: SVector::zeros(),
+            new: SVector::zeros(),
+        }
+    }
+}
+
+/// The grid velocities of a step: $v^n_i = p_i/m_i$ (eq. 30) and
+/// $\tilde v^{n+1}_i = v^n_i + \Delta t\,(f^{ext}_i + f^{int}_i)/m_i$ (eqs.
+/// 31–32). Entries outside `lo..hi` are stale and never read.
+#[derive(Debug, Clone, Default)]
+pub struct GridState<const D: usize> {
+    /// Lumped mass $m_i$.
+    pub mass: Vec<f64>,
+    /// The velocities.
+    pub velocity: Vec<NodeVelocity<D>>,
+    /// First node with mass.
+    pub lo: usize,
+    /// One past the last node with mass.
+    pub hi: usize,
+}
+
+impl<const D: usize> GridState<D> {
+    /// A grid of `nodes` nodes.
+    pub fn new(nodes: usize) -> Self {
+        Self {
+            mass: vec![0.0; nodes],
+            velocity: vec![NodeVelocity::default(); nodes],
+            lo: 0,
+            hi: 0,
+        }
+    }
+
+    /// The nodal acceleration $a_i = (\tilde v^{n+1}_i - v^n_i)/\Delta t$,
+    /// which after the fixities is the recomputed one of the notes.
+    pub fn acceleration(&self, node: usize, dt: f64) -> SVector<f64, D> {
+        (self.velocity[node].new - self.velocity[node].old) / dt
+    }
+}
+
+/// Sums the threads' `buffers` into `grid` and updates the velocities
+/// (eqs. 30–32); nodes without mass get zero velocity. Then the fixities:
+/// $\tilde v^{n+1}_i$ is set to the prescribed value, which recomputes the
+/// acceleration as the notes require (a fixity on a node without mass has
+/// no effect: no point reads it).
+pub fn update<const D: usize>(
+    buffers: &[GridBuffer<D>],
+    grid: &mut GridState<D>,
+    dt: f64,
+    fixities: &VelocityFixities,
+) {
+    let lo = buffers.iter().map(|b| b.lo).min().unwrap_or(usize::MAX);
+    let hi = buffers.iter().map(|b| b.hi).max().unwrap_or(0);
+    if lo >= hi {
+        grid.lo = 0;
+        grid.hi = 0;
+        return;
+    }
+    grid.lo = lo;
+    grid.hi = hi;
+    let (mass, velocity) = (&mut grid.mass[lo..hi], &mut grid.velocity[lo..hi]);
+    (
+        mass.par_chunks_mut(NODES_PER_TASK),
+        velocity.par_chunks_mut(NODES_PER_TASK),
+    )
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(task, (mass, velocity))| {
+            let start = lo + task * NODES_PER_TASK;
+            for (k, (m_out, v_out)) in mass.iter_mut().zip(velocity.iter_mut()).enumerate() {
+                let i = start + k;
+                let mut sum = NodeSums::<D>::ZERO;
+                for b in buffers {
+                    if i >= b.lo && i < b.hi {
+                        let n = &b.nodes[i];
+                        sum.mass += n.mass;
+                        sum.momentum += n.momentum;
+                        sum.force += n.force;
+                    }
+                }
+                *m_out = sum.mass;
+                *v_out = if sum.mass > 0.0 {
+                    let v = sum.momentum / sum.mass;
+                    NodeVelocity {
+                        old: v,
+                        new: v + sum.force * (dt / sum.mass),
+                    }
+                } else {
+                    NodeVelocity::default()
+                };
+            }
+        });
+    for &(node, component, value) in fixities.entries() {
+        if node >= lo && node < hi && grid.mass[node] > 0.0 {
+            grid.velocity[node].new[component] = value;
+        }
+    }
+}

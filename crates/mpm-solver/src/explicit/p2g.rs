@@ -1,0 +1,222 @@
+//! Stage 1, point to grid: lumped mass (eqs. 22, 28), momentum with the
+//! optional Taylor term (eq. 29), internal and external forces (eqs. 20–21).
+
+use std::ops::Range;
+
+use mpm_basis::{BasisFunction, Stencil};
+use nalgebra::{Matrix3, SVector};
+
+use super::transfer::Transfer;
+use crate::error::{BasisFailure, PointFailure};
+
+/// The sums of one node, stored together so that a point's update of a
+/// node touches one cache line rather than three.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodeSums<const D: usize> {
+    /// $m_i$ (eq. 28).
+    pub mass: f64,
+    /// $p_i = m_i v_i$ (eq. 29).
+    pub momentum: SVector<f64, D>,
+    /// $f^{ext}_i + f^{int}_i$ (eqs. 20–21).
+    pub force: SVector<f64, D>,
+}
+
+impl<const D: usize> NodeSums<D> {
+    /// Nothing.
+    pub const ZERO: Self = Self {
+        mass: 0.0,
+        momentum: SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
+        force: SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
+    };
+}
+
+/// Nodal sums of one thread's points. The array spans the whole mesh; only
+/// `lo..hi`, the nodes touched since the last [`GridBuffer::clear`], can be
+/// non-zero, so a thread whose points are spatially coherent clears and
+/// reduces little more than its share of the grid.
+#[derive(Debug, Clone)]
+pub struct GridBuffer<const D: usize> {
+    /// The sums per node.
+    pub nodes: Vec<NodeSums<D>>,
+    /// First touched node.
+    pub lo: usize,
+    /// One past the last touched node.
+    pub hi: usize,
+}
+
+impl<const D: usize> GridBuffer<D> {
+    /// Zeroed sums for `nodes` nodes.
+    pub fn new(nodes: usize) -> Self {
+        Self {
+            nodes: vec![NodeSums::ZERO; nodes],
+            lo: usize::MAX,
+            hi: 0,
+        }
+    }
+
+    /// Zeroes the touched range.
+    pub fn clear(&mut self) {
+        if self.lo < self.hi {
+            self.nodes[self.lo..self.hi].fill(NodeSums::ZERO);
+        }
+        self.lo = usize::MAX;
+        self.hi = 0;
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Whether the buffer has no nodes.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+}
+
+/// What the scatter reads from the points.
+#[derive(Debug, Clone, Copy)]
+pub struct PointsView<'a, const D: usize, T> {
+    /// Positions $x^n_p$.
+    pub position: &'a [SVector<f64, D>],
+    /// Velocities $v^n_p$.
+    pub velocity: &'a [SVector<f64, D>],
+    /// Masses.
+    pub mass: &'a [f64],
+    /// Initial volumes.
+    pub volume0: &'a [f64],
+    /// Kirchhoff stresses.
+    pub tau: &'a [Matrix3<f64>],
+    /// Transfer states.
+    pub transfer: &'a [T],
+}
+
+/// Streams the supporting nodes of the point at `x` into `visit`
+/// ([`BasisFunction::for_each_node`]), checking that every node id lies
+/// below `node_count`.
+///
+/// # Errors
+/// The basis cannot be evaluated at `x`, or it returned a node outside the
+/// mesh (a bug of the basis; nothing past that node is visited).
+#[inline(always)]
+pub fn visit_nodes<const D: usize, B: BasisFunction<D, Domain = ()>>(
+    basis: &B,
+    mesh: &B::Mesh,
+    x: &SVector<f64, D>,
+    node_count: usize,
+    stencil: &mut Stencil<D>,
+    mut visit: impl FnMut(usize, f64, &SVector<f64, D>),
+) -> Result<(), PointFailure> {
+    let fail = |source| PointFailure::Basis {
+        position: x.iter().copied().collect(),
+        source,
+    };
+    let mut outside = None;
+    basis
+        .for_each_node(mesh, x, &(), stencil, |i, w, g| {
+            if i < node_count {
+                if outside.is_none() {
+                    visit(i, w, g);
+                }
+            } else {
+                outside = Some(i);
+            }
+        })
+        .map_err(|e| fail(BasisFailure::Basis(e)))?;
+    match outside {
+        None => Ok(()),
+        Some(_) => Err(fail(BasisFailure::Stencil {
+            nodes: B::MAX_NODES + 1,
+            max: B::MAX_NODES,
+        })),
+    }
+}
+
+/// Scatters the points `range` into `buffer`: for every node $i$ of a
+/// point's stencil, $m_i \mathrel{+}= w_{ip}m_p$,
+/// $p_i \mathrel{+}= w_{ip}m_p\,(v_p + \nabla v_p(x_i - x_p))$ (the bracket
+/// from [`Transfer::nodal_velocity`]) and
+/// $f_i \mathrel{+}= w_{ip}m_p b - V^0_p\tau_p\nabla w_{ip}$ (eqs. 20–21
+/// with $V_p\sigma_p = V^0_p\tau_p$). `node_position` is read only by
+/// transfers with a Taylor term.
+///
+/// # Errors
+/// The first point whose basis cannot be evaluated, with its index.
+#[allow(clippy::too_many_arguments)]
+pub fn scatter<const D: usize, B, T>(
+    basis: &B,
+    mesh: &B::Mesh,
+    points: &PointsView<'_, D, T::PointState>,
+    node_position: &[SVector<f64, D>],
+    gravity: &SVector<f64, D>,
+    range: Range<usize>,
+    buffer: &mut GridBuffer<D>,
+    stencil: &mut Stencil<D>,
+) -> Result<(), (usize, PointFailure)>
+where
+    B: BasisFunction<D, Domain = ()>,
+    T: Transfer<D>,
+{
+    let node_count = buffer.len();
+    let (mut lo, mut hi) = (buffer.lo, buffer.hi);
+    let nodes = &mut buffer.nodes;
+    for p in range {
+        let x = &points.position[p];
+        let m = points.mass[p];
+        let v = &points.velocity[p];
+        let state = &points.transfer[p];
+        let stress = points.tau[p].fixed_view::<D, D>(0, 0) * points.volume0[p];
+        let body = gravity * m;
+        visit_nodes(basis, mesh, x, node_count, stencil, |i, w, g| {
+            let wm = w * m;
+            let carried = if T::TAYLOR {
+                T::nodal_velocity(v, state, &(node_position[i] - x))
+            } else {
+                *v
+            };
+            let node = &mut nodes[i];
+            node.mass += wm;
+            node.momentum += carried * wm;
+            node.force += body * w - stress * g;
+            lo = lo.min(i);
+            hi = hi.max(i + 1);
+        })
+        .map_err(|e| (p, e))?;
+    }
+    buffer.lo = lo;
+    buffer.hi = hi;
+    Ok(())
+}
+
+/// Adds applied point forces $w_{ip}f^{app}_p$ (eq. 21) to `buffer`.
+///
+/// # Errors
+/// As [`scatter`].
+pub fn scatter_point_forces<const D: usize, B: BasisFunction<D, Domain = ()>>(
+    basis: &B,
+    mesh: &B::Mesh,
+    position: &[SVector<f64, D>],
+    forces: &[(usize, SVector<f64, D>)],
+    buffer: &mut GridBuffer<D>,
+    stencil: &mut Stencil<D>,
+) -> Result<(), (usize, PointFailure)> {
+    let node_count = buffer.len();
+    for (p, f) in forces {
+        let (lo, hi) = (&mut buffer.lo, &mut buffer.hi);
+        let nodes = &mut buffer.nodes;
+        visit_nodes(
+            basis,
+            mesh,
+            &position[*p],
+            node_count,
+            stencil,
+            |i, w, _| {
+                nodes[i].force += f * w;
+                *lo = (*lo).min(i);
+                *hi = (*hi).max(i + 1);
+            },
+        )
+        .map_err(|e| (*p, e))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,100 @@
+//! The material points of an explicit run, one array per quantity.
+
+use nalgebra::{Matrix3, SVector};
+
+use crate::error::SolverError;
+
+/// Material points for the explicit solver (struct of arrays). `S` is the
+/// law's state ([`mpm_constitutive::IncrementalLaw::State`]) and `T` the
+/// transfer's ([`super::Transfer::PointState`]), so neither an elastic law
+/// nor a PIC transfer costs memory per point.
+#[derive(Debug, Clone)]
+pub struct ExplicitPoints<const D: usize, S, T> {
+    /// Position $x_p$.
+    pub position: Vec<SVector<f64, D>>,
+    /// Velocity $v_p$.
+    pub velocity: Vec<SVector<f64, D>>,
+    /// Mass $m_p$ (constant).
+    pub mass: Vec<f64>,
+    /// Initial volume $V^0_p$.
+    pub volume0: Vec<f64>,
+    /// Current volume $V_p = J_p V^0_p$ (eq. 40); the density is
+    /// $\rho_p = m_p / V_p$ (eq. 41).
+    pub volume: Vec<f64>,
+    /// Deformation gradient $F_p$ (eq. 39; 3×3, plane strain embedded).
+    pub f: Vec<Matrix3<f64>>,
+    /// Kirchhoff stress $\tau_p = J_p\sigma_p$, so that the internal force
+    /// of eq. (20) is $-V^0_p\tau_p\nabla w_{ip}$.
+    pub tau: Vec<Matrix3<f64>>,
+    /// The law's state (e.g. $b^e$ and plastic history).
+    pub material: Vec<S>,
+    /// The transfer's state (e.g. $\nabla v_p$ for the Taylor transfer).
+    pub transfer: Vec<T>,
+    /// Applied point forces $f^{app}_p$ of eq. (21) (point index, force);
+    /// empty when the scene has none.
+    pub point_force: Vec<(usize, SVector<f64, D>)>,
+}
+
+impl<const D: usize, S, T> ExplicitPoints<D, S, T> {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    /// Whether there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+}
+
+impl<const D: usize, S: Copy + Default, T: Copy + Default> ExplicitPoints<D, S, T> {
+    /// Unstressed points at rest with the given positions and volumes and a
+    /// uniform density.
+    ///
+    /// # Errors
+    /// Mismatched lengths, non-positive or non-finite volumes, non-finite
+    /// positions, a negative or non-finite density.
+    pub fn new(
+        position: Vec<SVector<f64, D>>,
+        volume: Vec<f64>,
+        density: f64,
+    ) -> Result<Self, SolverError> {
+        let n = position.len();
+        if volume.len() != n {
+            return Err(SolverError::InvalidInput(format!(
+                "{n} positions but {} volumes",
+                volume.len()
+            )));
+        }
+        crate::points::check_points(&position, &volume)?;
+        if !(density.is_finite() && density > 0.0) {
+            return Err(SolverError::InvalidInput(format!(
+                "density {density} must be positive and finite"
+            )));
+        }
+        Ok(Self {
+            velocity: vec![SVector::zeros(); n],
+            mass: volume.iter().map(|v| v * density).collect(),
+            volume0: volume.clone(),
+            volume,
+            f: vec![Matrix3::identity(); n],
+            tau: vec![Matrix3::zeros(); n],
+            material: vec![S::default(); n],
+            transfer: vec![T::default(); n],
+            point_force: Vec::new(),
+            position,
+        })
+    }
+
+    /// Sets every point's velocity from a function of its position.
+    pub fn set_velocity(&mut self, v: impl Fn(&SVector<f64, D>) -> SVector<f64, D>) {
+        for (x, vel) in self.position.iter().zip(&mut self.velocity) {
+            *vel = v(x);
+        }
+    }
+
+    /// The Cauchy stress $\sigma_p = \tau_p / J_p$ of point `p`.
+    pub fn cauchy(&self, p: usize) -> Matrix3<f64> {
+        self.tau[p] / self.f[p].determinant()
+    }
+}
