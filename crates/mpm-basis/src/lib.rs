@@ -36,6 +36,7 @@
 #![cfg_attr(test, allow(clippy::unwrap_used))]
 
 mod basis;
+mod boundary_bspline;
 mod corners;
 mod cpdi2;
 mod error;
@@ -47,6 +48,7 @@ mod stencil;
 mod tensor;
 
 pub use basis::BasisFunction;
+pub use boundary_bspline::BoundaryBSpline;
 pub use corners::{Corners, MAX_CORNERS, reference_shape};
 pub use cpdi2::{Cpdi2, DomainIntegrals};
 pub use error::BasisError;

@@ -100,35 +100,55 @@ impl QuadraticBSpline {
         let mut axes = [AxisFactors::<3>::EMPTY; D];
         for (i, axis) in axes.iter_mut().enumerate() {
             let (k, t, h) = (location.cell[i], location.local[i], mesh.spacing()[i]);
-            // Nodes k-1..=k+1 when t < 1/2, k..=k+2 otherwise; node j sits at
-            // r = t + k - j. A node at exactly |r| = 3/2 has a zero factor and
-            // zero slope and is skipped, so the admissible region is closed.
-            // With fx = r of the first node in [0.5, 1.5): the three
-            // factors of eqs. (24)-(25) without branches (the quadratic
-            // pieces at r = fx, fx - 1, fx - 2).
-            let (first, fx) = if t < 0.5 {
-                (k.wrapping_sub(1), t + 1.0)
-            } else {
-                (k, t)
-            };
-            let (a, b, c) = (1.5 - fx, fx - 1.0, fx - 0.5);
-            let values = [0.5 * a * a, 0.75 - b * b, 0.5 * c * c];
-            let slopes = [-a, -2.0 * b, c];
-            for (offset, (n, dn)) in values.into_iter().zip(slopes).enumerate() {
-                if n == 0.0 && dn == 0.0 {
-                    continue;
-                }
-                let node = first.wrapping_add(offset);
-                if node > cells[i] {
-                    return Err(BasisError::StencilOutsideGrid {
-                        point: position.iter().copied().collect(),
-                        axis: i,
-                    });
-                }
-                axis.push(node, n, dn / h);
-            }
+            Self::push_axis(axis, k, t, h, cells[i], position, i)?;
         }
         Ok(axes)
+    }
+
+    /// Pushes the factors along axis `i` of a point in cell `k` at local
+    /// coordinate `t` (cell size `h`, `cells` cells on the axis).
+    ///
+    /// # Errors
+    /// [`BasisError::StencilOutsideGrid`] when a node of the stencil lies
+    /// beyond the grid.
+    #[inline(always)]
+    pub(crate) fn push_axis<const D: usize>(
+        axis: &mut AxisFactors<3>,
+        k: usize,
+        t: f64,
+        h: f64,
+        cells: usize,
+        position: &SVector<f64, D>,
+        i: usize,
+    ) -> Result<(), BasisError> {
+        // Nodes k-1..=k+1 when t < 1/2, k..=k+2 otherwise; node j sits at
+        // r = t + k - j. With fx = r of the first node, in [0.5, 1.5), the
+        // three factors of eqs. (24)-(25) need no branch (the quadratic
+        // pieces at r = fx, fx - 1, fx - 2). A node at exactly |r| = 3/2
+        // has a zero factor and zero slope and is skipped, so the
+        // admissible region is closed.
+        let (first, fx) = if t < 0.5 {
+            (k.wrapping_sub(1), t + 1.0)
+        } else {
+            (k, t)
+        };
+        let (a, b, c) = (1.5 - fx, fx - 1.0, fx - 0.5);
+        let values = [0.5 * a * a, 0.75 - b * b, 0.5 * c * c];
+        let slopes = [-a, -2.0 * b, c];
+        for (offset, (n, dn)) in values.into_iter().zip(slopes).enumerate() {
+            if n == 0.0 && dn == 0.0 {
+                continue;
+            }
+            let node = first.wrapping_add(offset);
+            if node > cells {
+                return Err(BasisError::StencilOutsideGrid {
+                    point: position.iter().copied().collect(),
+                    axis: i,
+                });
+            }
+            axis.push(node, n, dn / h);
+        }
+        Ok(())
     }
 }
 

@@ -8,7 +8,10 @@
 mod common;
 
 use common::*;
-use mpm_basis::{BasisFunction, Corners, Cpdi2, Gimp, LinearMpm, LinearSimplex, QuadraticBSpline};
+use mpm_basis::{
+    BasisFunction, BoundaryBSpline, Corners, Cpdi2, Gimp, LinearMpm, LinearSimplex,
+    QuadraticBSpline,
+};
 use mpm_mesh::SimplexMesh;
 use nalgebra::SVector;
 use proptest::prelude::*;
@@ -107,6 +110,16 @@ fn bspline_bound<const D: usize>(x: &SVector<f64, D>, _: &(), axis: usize) -> Op
     let hi = node_line(axis, CELLS[axis]) - 0.5 * h;
     let margin = 2.0 * fd_step(axis);
     (x[axis] - margin >= lo && x[axis] + margin <= hi).then_some(2.0 / (h * h))
+}
+
+/// The boundary-modified spline is C¹ and piecewise quadratic (linear on
+/// the boundary half cells) everywhere in the grid: the spline's bound,
+/// away from the grid boundary by the finite-difference margin.
+fn boundary_bspline_bound<const D: usize>(x: &SVector<f64, D>, _: &(), axis: usize) -> Option<f64> {
+    let h = SPACING[axis];
+    let margin = 2.0 * fd_step(axis);
+    (x[axis] - margin >= ORIGIN[axis] && x[axis] + margin <= node_line(axis, CELLS[axis]))
+        .then_some(2.0 / (h * h))
 }
 
 /// CPDI2: the gradient (domain average of the gradient of the corner
@@ -235,3 +248,17 @@ fn simplex_finite_difference_check_applies_inside_elements() {
     }
     assert!(applicable >= 50, "only {applicable} of 200 cases checked");
 }
+basis_properties!(
+    boundary_bspline_2d,
+    BoundaryBSpline,
+    2,
+    boundary_bspline_cases::<2>(),
+    boundary_bspline_bound::<2>
+);
+basis_properties!(
+    boundary_bspline_3d,
+    BoundaryBSpline,
+    3,
+    boundary_bspline_cases::<3>(),
+    boundary_bspline_bound::<3>
+);

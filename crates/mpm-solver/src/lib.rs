@@ -5,8 +5,11 @@
 //!
 //! | plug point | implementations | paper |
 //! |---|---|---|
-//! | `mpm_basis::BasisFunction` | `LinearMpm`, `Gimp`, `Cpdi2`, `QuadraticBSpline`, `LinearSimplex` | Coombs et al. 2020 §6.1; Wang et al. 2021 §2.3 |
-//! | `mpm_constitutive::LogStrainLaw` | `HenckyElastic`, `VonMises` | Coombs et al. 2020 §2 |
+//! | `mpm_basis::BasisFunction` | `LinearMpm`, `Gimp`, `Cpdi2`, `QuadraticBSpline`, `BoundaryBSpline`, `LinearSimplex` | Coombs et al. 2020 §6.1; Wang et al. 2021 §2.3; MPoint notes eqs. 24–27 |
+//! | `mpm_constitutive::LogStrainLaw` | `HenckyElastic`, `VonMises`, `NeoHookean` | Coombs et al. 2020 §2 |
+//! | `mpm_constitutive::IncrementalLaw` (explicit) | `NeoHookean`, `Spectral<L>` | MPoint notes eqs. 38–44 |
+//! | [`explicit::Transfer`] (explicit) | [`Pic`], [`Flip`], [`FlipPic`], [`Taylor`] | MPoint notes eqs. 29, 34–36 |
+//! | [`explicit::DilatationTreatment`] (explicit) | [`NoLocking`], [`CellAveraged`] | MPoint notes eqs. 47–53 |
 //! | [`Formulation`] | [`UpdatedLagrangian`], [`PreviouslyConverged`] | §3, §5 |
 //! | [`LockingTreatment`] | [`NoLocking`], [`FBar`], [`FPatch`] | Wang et al. 2021 §3.2; Coombs et al. 2018 |
 //! | [`DomainUpdater`] (or the shorter [`DeformationRule`]) | [`NoUpdate`], [`DetF`], [`DiagF`], [`StretchU`], [`CornerMidpoint`], [`Midpoint`], [`VolumeCorrectedDiagF`], [`IncrementalVolumeCorrectedDiagF`], [`ConvectedCorners`], [`DomainVolume`] | Coombs et al. 2020 §6.4 |
@@ -16,7 +19,9 @@
 //! [`SolverParts`] names the components of a solver and the bounds between
 //! them once; [`ImplicitSolver`] composes them into the quasi-static
 //! Newton–Raphson solver of Coombs et al. 2020 §6.3, and [`LoadStepping`]
-//! drives it through load steps with automatic step control. The stages
+//! drives it through load steps with automatic step control;
+//! [`ExplicitSolver`] is the explicit dynamic solver of the MPoint notes
+//! (module [`explicit`]). The stages
 //! of a step are free functions in [`stages`] (basis evaluation,
 //! point-to-grid gathers, grid-to-point updates, the convergence test), so
 //! other solvers reuse them. [`ImplicitBuilder`] composes a solver from

@@ -241,6 +241,20 @@ pub fn bspline_cases<const D: usize>() -> BoxedStrategy<(SVector<f64, D>, ())> {
     axes.prop_map(|x| (to_vector(x), ())).boxed()
 }
 
+/// Boundary-modified B-spline cases: the whole closed grid, often exactly on
+/// node lines (the boundary included) or cell mid-lines, where the linear
+/// boundary half cells meet the splines.
+pub fn boundary_bspline_cases<const D: usize>() -> BoxedStrategy<(SVector<f64, D>, ())> {
+    let axes: Vec<_> = (0..D)
+        .map(|i| {
+            let mut snaps = node_lines(i);
+            snaps.extend(mid_lines(i));
+            coordinate(ORIGIN[i], node_line(i, CELLS[i]), snaps)
+        })
+        .collect();
+    axes.prop_map(|x| (to_vector(x), ())).boxed()
+}
+
 /// CPDI2 cases, a mix of
 /// - small parallelograms/parallelepipeds inside one cell, in 3D with edges
 ///   parallel to coordinate planes (where the gradient is the derivative of

@@ -249,6 +249,18 @@ where
         self.steps
     }
 
+    /// Sets the clock of a resumed run: the time, the steps taken and the
+    /// work of the applied forces so far (as [`Self::time`],
+    /// [`Self::steps`] and [`Self::external_work`] returned them when the
+    /// checkpoint was written). The next time increment is recomputed from
+    /// the points.
+    pub fn resume_at(&mut self, time: f64, steps: usize, external_work: f64) {
+        self.time = time;
+        self.steps = steps;
+        self.external_work = external_work;
+        self.max_signal = None;
+    }
+
     /// Wall time per stage so far.
     pub fn stage_times(&self) -> &ExplicitStageTimes {
         &self.stage_times
