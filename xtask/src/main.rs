@@ -37,6 +37,7 @@ mod indentation;
 mod locking;
 mod machine;
 mod markdown;
+mod mpoint;
 mod plate;
 mod plot;
 mod reference_values;
@@ -69,6 +70,12 @@ tasks:
                 Cook's membrane (plane strain, nu = 0.3 and 0.4999, small and full
                 load) for standard MPM, F-patch and F-bar against refinement;
                 writes docs/src/reproduction/locking.md and its PNG plots.
+  reproduce mpoint [--full]
+                the explicit solver (MPoint theory notes): vibrating bar in h and dt,
+                energy by transfer, colliding disks, cell-averaged dilatation,
+                dynamic collapse, elastic-cube throughput on 1 and 2 threads;
+                writes docs/src/reproduction/mpoint.md and its PNG plots.
+                --full adds the 128^3 cube.
   column-table  error and run time of the column case, written to
                 docs/src/benchmarks/column.md
   reference-values
@@ -109,7 +116,17 @@ fn main() -> Result<()> {
                 no_more_arguments(&args[2..])?;
                 locking::run(&docs_dir())
             }
-            Some(other) => bail!("unknown paper `{other}`; known: coombs2020, wang2021, locking"),
+            Some("mpoint") => {
+                let full = match &args[2..] {
+                    [] => false,
+                    [flag] if flag == "--full" => true,
+                    [other, ..] => bail!("unexpected argument `{other}` (expected --full)"),
+                };
+                mpoint::run(full, &docs_dir())
+            }
+            Some(other) => {
+                bail!("unknown paper `{other}`; known: coombs2020, wang2021, locking, mpoint")
+            }
             None => {
                 bail!("`reproduce` needs a paper: `reproduce coombs2020` or `reproduce wang2021`")
             }

@@ -1,12 +1,11 @@
 //! Explicit solver throughput on the elastic-cube drop of issue 15
-//! (`common/cube.rs`) on 32³, 64³ (and with
+//! (`mpm_solver::explicit::verification::elastic_cube`) on 32³, 64³ (and with
 //! `MPM_BENCH_LARGE=1`, 128³) cells, on 1 and 2 threads. Criterion reports
 //! time per step; particle-steps per second = points / time (printed).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 
-#[path = "common/cube.rs"]
-mod cube;
+use mpm_solver::explicit::verification::elastic_cube;
 
 fn bench(c: &mut Criterion) {
     let mut sizes = vec![32, 64];
@@ -21,7 +20,7 @@ fn bench(c: &mut Criterion) {
                 .num_threads(threads)
                 .build()
                 .expect("pool");
-            let (mut solver, mut points) = cube::cube(n);
+            let (mut solver, mut points) = elastic_cube(n).expect("cube");
             group.throughput(Throughput::Elements(points.len() as u64));
             group.bench_function(BenchmarkId::new(format!("{threads}_threads"), n), |b| {
                 b.iter(|| pool.install(|| solver.step(&mut points, f64::INFINITY).expect("step")));

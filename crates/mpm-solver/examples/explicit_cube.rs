@@ -5,8 +5,7 @@
 
 use std::time::Instant;
 
-#[path = "../benches/common/cube.rs"]
-mod cube;
+use mpm_solver::explicit::verification::elastic_cube;
 
 fn main() {
     let args: Vec<usize> = std::env::args()
@@ -22,7 +21,7 @@ fn main() {
         .num_threads(threads)
         .build()
         .expect("pool");
-    let (mut solver, mut points) = cube::cube(n);
+    let (mut solver, mut points) = elastic_cube(n).expect("cube");
     let mut rates = Vec::new();
     pool.install(|| {
         for _ in 0..steps {

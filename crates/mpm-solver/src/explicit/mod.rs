@@ -38,6 +38,7 @@ pub mod options;
 pub mod p2g;
 pub mod points;
 pub mod transfer;
+pub mod verification;
 
 use mpm_basis::BasisFunction;
 use mpm_constitutive::IncrementalLaw;
