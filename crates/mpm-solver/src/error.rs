@@ -126,6 +126,21 @@ pub enum SolverError {
         #[source]
         reason: PointFailure,
     },
+    /// A fixed explicit time increment exceeds the stable increment of the
+    /// CFL condition (MPoint notes eq. 45) for the current state.
+    #[error(
+        "explicit step {step} at t = {time:e}: the fixed Δt = {dt:e} exceeds the CFL limit h/max(c + |v|) = {limit:e} (Courant number {ratio:.3}); the run would become unstable — use a smaller Δt or the CFL rule", ratio = dt / limit
+    )]
+    CflExceeded {
+        /// The step (counting from 1) that was refused.
+        step: usize,
+        /// The time at its start.
+        time: f64,
+        /// The fixed increment.
+        dt: f64,
+        /// The stable increment.
+        limit: f64,
+    },
     /// Inconsistent problem set-up.
     #[error("invalid input: {0}")]
     InvalidInput(String),

@@ -416,3 +416,62 @@ fn fixed_end_bar_is_second_order_with_the_boundary_spline() {
     );
     assert!(plain[3] > 10.0 * modified[3]);
 }
+
+/// A fixed Δt at 1.5× and 3× the CFL limit is refused at the first step,
+/// before any state changes, with the Courant number in the message; at
+/// 0.5× the run proceeds (the limit moves with the state: at 0.9× this
+/// stretching bar is refused at step 12, when its waves have raised
+/// max(c + |v|) by 11 %).
+#[test]
+fn fixed_steps_beyond_the_cfl_limit_are_refused_before_they_blow_up() {
+    let run = |courant: f64| {
+        let grid =
+            RegularGrid::new(Vector2::new(-0.5, -0.5), Vector2::new(0.5, 0.5), [22, 3]).unwrap();
+        let (x0, vol) = block(Vector2::zeros(), Vector2::new(10.0, 0.5), 0.5, 2);
+        let mut points: PointsFor<2, NeoHookean, Flip> =
+            ExplicitPoints::new(x0.clone(), vol, 1.0).unwrap();
+        points.set_velocity(|x| Vector2::new(0.01 * x.x, 0.0));
+        let law = NeoHookean::new(100.0, 0.3).unwrap();
+        let c = (mpm_constitutive::IncrementalLaw::p_wave_modulus(&law) / 1.0).sqrt();
+        let limit = 0.5 / (c + 0.1);
+        let options = ExplicitOptions {
+            time_step: TimeStep::Fixed(courant * limit),
+            ..Default::default()
+        };
+        let mut solver = ExplicitSolver::new(
+            QuadraticBSpline,
+            grid,
+            law,
+            Flip,
+            NoLocking,
+            VelocityFixities::new(),
+            options,
+        )
+        .unwrap();
+        let result = solver.run_until(&mut points, 100.0 * limit, |_, _, _| Ok(()));
+        (result, points.position == x0)
+    };
+    for courant in [1.5, 3.0] {
+        let (result, untouched) = run(courant);
+        match result {
+            Err(SolverError::CflExceeded {
+                step: 1, dt, limit, ..
+            }) => {
+                assert!(
+                    (dt / limit - courant).abs() < 1e-2 * courant,
+                    "{dt} / {limit}"
+                );
+                assert!(untouched, "the refused step must not move the points");
+            }
+            other => panic!("Courant {courant}: expected the CFL refusal, got {other:?}"),
+        }
+        let text = run(courant).0.unwrap_err().to_string();
+        assert!(
+            text.contains("exceeds the CFL limit") && text.contains("Courant number"),
+            "{text}"
+        );
+    }
+    let (result, _) = run(0.5);
+    assert!(result.is_ok(), "{result:?}");
+    assert!(matches!(run(0.9).0, Err(SolverError::CflExceeded { step: 12, .. })));
+}

@@ -277,28 +277,30 @@ where
     pub fn time_increment(&mut self, points: &PointsFor<D, L, T>) -> f64 {
         match self.options.time_step {
             TimeStep::Fixed(dt) => dt,
-            TimeStep::Cfl { factor } => {
-                let m = self.law.p_wave_modulus();
-                let signal = *self.max_signal.get_or_insert_with(|| {
-                    (0..points.len())
-                        .map(|p| {
-                            g2p::signal_speed(
-                                m,
-                                points.mass[p],
-                                points.volume[p],
-                                &points.velocity[p],
-                            )
-                        })
-                        .fold(0.0, f64::max)
-                });
-                factor * self.mesh.min_spacing() / signal
-            }
+            TimeStep::Cfl { factor } => factor * self.stable_increment(points),
         }
+    }
+
+    /// The stable increment of eq. (45), $h/\max_p(c_p + \|v_p\|)$, for the
+    /// points' current state (from the last step's grid-to-point stage, or
+    /// computed from the points before the first step).
+    pub fn stable_increment(&mut self, points: &PointsFor<D, L, T>) -> f64 {
+        let m = self.law.p_wave_modulus();
+        let signal = *self.max_signal.get_or_insert_with(|| {
+            (0..points.len())
+                .map(|p| {
+                    g2p::signal_speed(m, points.mass[p], points.volume[p], &points.velocity[p])
+                })
+                .fold(0.0, f64::max)
+        });
+        self.mesh.min_spacing() / signal
     }
 
     /// Advances the points by one step of at most `max_dt`.
     ///
     /// # Errors
+    /// [`SolverError::CflExceeded`] when a fixed increment exceeds the
+    /// stable one of eq. (45) (the state is then left as it was);
     /// [`SolverError::ExplicitPoint`] naming the point, the step and the
     /// time when a point leaves the grid, inverts, or its stress update
     /// fails. The points may then be partly updated; keep a copy (or a
@@ -313,6 +315,17 @@ where
             return Err(SolverError::InvalidInput(format!(
                 "time increment {dt} (limit {max_dt}) must be positive and finite"
             )));
+        }
+        // A fixed increment beyond the CFL limit would grow every wave
+        // mode until the stresses overflow: stop before the step instead.
+        let stable = self.stable_increment(points);
+        if dt > stable {
+            return Err(SolverError::CflExceeded {
+                step: self.steps + 1,
+                time: self.time,
+                dt,
+                limit: stable,
+            });
         }
         let fail =
             |this: &Self, (point, reason): (usize, PointFailure)| SolverError::ExplicitPoint {
