@@ -136,6 +136,7 @@ where
     steps: usize,
     external_work: f64,
     stage_times: ExplicitStageTimes,
+    fixed_start: Vec<f64>,
 }
 
 impl<const D: usize, B, L, T, K> ExplicitSolver<D, B, L, T, K>
@@ -207,6 +208,7 @@ where
             steps: 0,
             external_work: 0.0,
             stage_times: ExplicitStageTimes::default(),
+            fixed_start: Vec::new(),
         })
     }
 
@@ -334,10 +336,14 @@ where
                 point,
                 reason,
             };
+        self.hold_fixed_points(points)?;
         let clock = std::time::Instant::now();
         self.point_to_grid(points).map_err(|e| fail(self, e))?;
         let scattered = clock.elapsed().as_secs_f64();
         grid_update::update(&self.buffers, &mut self.grid, dt, &self.fixities);
+        if !points.fixed_velocity.is_empty() {
+            self.hold_on_grid(points).map_err(|e| fail(self, e))?;
+        }
         let updated = clock.elapsed().as_secs_f64();
         let work = self.point_force_power(points);
         let signal = if K::AVERAGES {
@@ -347,6 +353,10 @@ where
         }
         .map_err(|e| fail(self, e))?;
         let gathered = clock.elapsed().as_secs_f64();
+        for (k, &(p, c, v)) in points.fixed_velocity.iter().enumerate() {
+            points.velocity[p][c] = v;
+            points.position[p][c] = self.fixed_start[k] + dt * v;
+        }
         self.stage_times.p2g += scattered;
         self.stage_times.grid += updated - scattered;
         self.stage_times.g2p += gathered - updated;
@@ -389,6 +399,52 @@ where
     /// A law without a stored energy.
     pub fn energies(&self, points: &PointsFor<D, L, T>) -> Result<Energies, SolverError> {
         energy::energies(&self.law, &self.options.gravity, points, self.external_work)
+    }
+
+    /// Checks the material-point fixities, sets the fixed velocity
+    /// components (so that the momentum they bring to the grid is the
+    /// prescribed one) and keeps the fixed position components of the step's
+    /// start.
+    fn hold_fixed_points(&mut self, points: &mut PointsFor<D, L, T>) -> Result<(), SolverError> {
+        self.fixed_start.clear();
+        for &(p, c, v) in &points.fixed_velocity {
+            if p >= points.len() || c >= D || !v.is_finite() {
+                return Err(SolverError::InvalidInput(format!(
+                    "material-point fixity ({p}, {c}) = {v}: there are {} points of {D} components and velocities must be finite",
+                    points.len()
+                )));
+            }
+            points.velocity[p][c] = v;
+            self.fixed_start.push(points.position[p][c]);
+        }
+        Ok(())
+    }
+
+    /// The grid side of the material-point fixities
+    /// ([`grid_update::hold_points`]).
+    fn hold_on_grid(&mut self, points: &PointsFor<D, L, T>) -> Result<(), (usize, PointFailure)> {
+        let mut stencil = self.basis.new_stencil();
+        let mut stencils = Vec::with_capacity(points.fixed_velocity.len());
+        for &(p, _, _) in &points.fixed_velocity {
+            let mut pairs = Vec::with_capacity(B::MAX_NODES);
+            p2g::visit_nodes(
+                &self.basis,
+                &self.mesh,
+                &points.position[p],
+                self.node_count,
+                &mut stencil,
+                |i, w, _| pairs.push((i, w)),
+            )
+            .map_err(|e| (p, e))?;
+            stencils.push(pairs);
+        }
+        grid_update::hold_points(
+            &mut self.grid,
+            &points.fixed_velocity,
+            &stencils,
+            &self.fixities,
+        );
+        Ok(())
     }
 
     fn point_force_power(&self, points: &PointsFor<D, L, T>) -> f64 {

@@ -33,6 +33,13 @@ pub struct ExplicitPoints<const D: usize, S, T> {
     /// Applied point forces $f^{app}_p$ of eq. (21) (point index, force);
     /// empty when the scene has none.
     pub point_force: Vec<(usize, SVector<f64, D>)>,
+    /// Material-point fixities (point index, component, velocity): the
+    /// MPoint alternative to nodal fixities. The component of the point's
+    /// velocity is held at the value — in the momentum it brings to the
+    /// grid, on the grid through a Lagrange multiplier per point
+    /// ([`super::grid_update::hold_points`]) and after every step — and its
+    /// position moves with it; empty when the scene has none.
+    pub fixed_velocity: Vec<(usize, usize, f64)>,
 }
 
 impl<const D: usize, S, T> ExplicitPoints<D, S, T> {
@@ -82,6 +89,7 @@ impl<const D: usize, S: Copy + Default, T: Copy + Default> ExplicitPoints<D, S, 
             material: vec![S::default(); n],
             transfer: vec![T::default(); n],
             point_force: Vec::new(),
+            fixed_velocity: Vec::new(),
             position,
         })
     }
