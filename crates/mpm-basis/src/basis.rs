@@ -97,6 +97,26 @@ pub trait BasisFunction<const D: usize>: Send + Sync {
         Ok(())
     }
 
+    /// For a tensor-product basis on a regular grid: the per-axis factors
+    /// of the point at `position`, whose products are exactly the stencil
+    /// [`evaluate`](Self::evaluate) lists (up to nodes whose product is
+    /// zero in value and gradient). `None` (the default) when the basis
+    /// has no such structure; a solver then uses
+    /// [`for_each_node`](Self::for_each_node).
+    ///
+    /// # Errors
+    /// As [`evaluate`](Self::evaluate), inside the `Some`.
+    #[inline]
+    fn tensor_factors(
+        &self,
+        mesh: &Self::Mesh,
+        position: &SVector<f64, D>,
+        domain: &Self::Domain,
+    ) -> Option<Result<crate::TensorFactors<D>, BasisError>> {
+        let _ = (mesh, position, domain);
+        None
+    }
+
     /// An empty stencil with room for [`BasisFunction::MAX_NODES`] nodes.
     fn new_stencil(&self) -> Stencil<D> {
         Stencil::with_capacity(Self::MAX_NODES)

@@ -5,8 +5,8 @@ use mpm_mesh::RegularGrid;
 use nalgebra::SVector;
 
 use crate::quadratic_bspline::QuadraticBSpline;
-use crate::tensor::{AxisFactors, tensor_product, visit_product};
-use crate::{BasisError, BasisFunction, Stencil};
+use crate::tensor::{AxisFactors, tensor_factors, tensor_product, visit_product};
+use crate::{BasisError, BasisFunction, Stencil, TensorFactors};
 
 /// The uniform quadratic B-spline of [`QuadraticBSpline`] away from the
 /// grid boundary, modified within half a cell of it so that the basis
@@ -86,6 +86,19 @@ impl<const D: usize> BasisFunction<D> for BoundaryBSpline {
         out.clear();
         let axes = Self::axis_factors(mesh, position)?;
         tensor_product(mesh, &axes, out)
+    }
+
+    #[inline]
+    fn tensor_factors(
+        &self,
+        mesh: &RegularGrid<D>,
+        position: &SVector<f64, D>,
+        _domain: &(),
+    ) -> Option<Result<TensorFactors<D>, BasisError>> {
+        match Self::axis_factors(mesh, position) {
+            Ok(axes) => tensor_factors(mesh, position, &axes).map(Ok),
+            Err(e) => Some(Err(e)),
+        }
     }
 
     #[inline]

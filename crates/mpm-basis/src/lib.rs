@@ -57,3 +57,4 @@ pub use linear_mpm::LinearMpm;
 pub use linear_simplex::LinearSimplex;
 pub use quadratic_bspline::QuadraticBSpline;
 pub use stencil::Stencil;
+pub use tensor::TensorFactors;

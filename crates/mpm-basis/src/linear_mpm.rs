@@ -4,8 +4,8 @@
 use mpm_mesh::RegularGrid;
 use nalgebra::SVector;
 
-use crate::tensor::{AxisFactors, tensor_product, visit_product};
-use crate::{BasisError, BasisFunction, Stencil};
+use crate::tensor::{AxisFactors, tensor_factors, tensor_product, visit_product};
+use crate::{BasisError, BasisFunction, Stencil, TensorFactors};
 
 /// The standard material point method basis: $S_{vp} = N_v(\mathbf x_p)$,
 /// $\nabla S_{vp} = \nabla N_v(\mathbf x_p)$ with $N_v$ the bilinear (2D) /
@@ -46,6 +46,19 @@ impl<const D: usize> BasisFunction<D> for LinearMpm {
     ) -> Result<(), BasisError> {
         out.clear();
         tensor_product(mesh, &axis_factors(mesh, position)?, out)
+    }
+
+    #[inline]
+    fn tensor_factors(
+        &self,
+        mesh: &RegularGrid<D>,
+        position: &SVector<f64, D>,
+        _domain: &(),
+    ) -> Option<Result<TensorFactors<D>, BasisError>> {
+        match axis_factors(mesh, position) {
+            Ok(axes) => tensor_factors(mesh, position, &axes).map(Ok),
+            Err(e) => Some(Err(e)),
+        }
     }
 
     #[inline]

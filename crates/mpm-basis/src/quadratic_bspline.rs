@@ -3,8 +3,8 @@
 use mpm_mesh::RegularGrid;
 use nalgebra::SVector;
 
-use crate::tensor::{AxisFactors, tensor_product, visit_product};
-use crate::{BasisError, BasisFunction, Stencil};
+use crate::tensor::{AxisFactors, tensor_factors, tensor_product, visit_product};
+use crate::{BasisError, BasisFunction, Stencil, TensorFactors};
 
 /// Uniform quadratic B-spline basis (Steffen et al. 2008; MPoint theory
 /// notes eqs. 24–27), one spline centred at every grid node:
@@ -72,6 +72,19 @@ impl<const D: usize> BasisFunction<D> for QuadraticBSpline {
         out.clear();
         let axes = Self::axis_factors(mesh, position)?;
         tensor_product(mesh, &axes, out)
+    }
+
+    #[inline]
+    fn tensor_factors(
+        &self,
+        mesh: &RegularGrid<D>,
+        position: &SVector<f64, D>,
+        _domain: &(),
+    ) -> Option<Result<TensorFactors<D>, BasisError>> {
+        match Self::axis_factors(mesh, position) {
+            Ok(axes) => tensor_factors(mesh, position, &axes).map(Ok),
+            Err(e) => Some(Err(e)),
+        }
     }
 
     #[inline]

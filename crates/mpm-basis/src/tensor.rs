@@ -44,6 +44,69 @@ impl<const K: usize> AxisFactors<K> {
     }
 }
 
+/// A tensor-product stencil given by its factors: along axis `i` the nodes
+/// with index `first[i]`, …, `first[i] + len[i] - 1` (consecutive), with
+/// the 1D values `value[i][k]` and slopes `slope[i][k]` (per unit length);
+/// the weight of node $(k_0, k_1, …)$ is $\prod_i$ `value[i][k_i]` and its
+/// gradient component $j$ is `slope[j][k_j]` $\prod_{i \ne j}$
+/// `value[i][k_i]`. Solvers that exploit the structure contract one axis at
+/// a time (sum factorisation) instead of visiting $3^D$ full products; see
+/// [`crate::BasisFunction::tensor_factors`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TensorFactors<const D: usize> {
+    /// Id of the node with the lowest index on every axis.
+    pub first_id: usize,
+    /// Node id strides per axis (1 along the first axis).
+    pub strides: [usize; D],
+    /// Index of the first node along every axis.
+    pub first: [usize; D],
+    /// Number of nodes along every axis (at most 3).
+    pub len: [usize; D],
+    /// 1D values.
+    pub value: [[f64; 3]; D],
+    /// 1D slopes (derivatives with respect to the coordinate).
+    pub slope: [[f64; 3]; D],
+    /// Coordinate of the first node along every axis minus the point's.
+    pub first_offset: [f64; D],
+    /// Grid spacing per axis.
+    pub spacing: [f64; D],
+}
+
+/// The [`TensorFactors`] of per-axis factors of at most 3 consecutive
+/// nodes, or `None` when the factors are not consecutive (the solver then
+/// uses the general path).
+#[inline(always)]
+pub(crate) fn tensor_factors<const D: usize, const K: usize>(
+    grid: &RegularGrid<D>,
+    position: &SVector<f64, D>,
+    axes: &[AxisFactors<K>; D],
+) -> Option<TensorFactors<D>> {
+    let strides = grid.node_strides();
+    let mut f = TensorFactors {
+        first_id: 0,
+        strides,
+        first: [0; D],
+        len: [0; D],
+        value: [[0.0; 3]; D],
+        slope: [[0.0; 3]; D],
+        first_offset: [0.0; D],
+        spacing: [0.0; D],
+    };
+    for (i, a) in axes.iter().enumerate() {
+        if a.len == 0 || a.len > 3 || (0..a.len).any(|c| a.index[c] != a.index[0] + c) {
+            return None;
+        }
+        f.first[i] = a.index[0];
+        f.len[i] = a.len;
+        f.value[i][..a.len].copy_from_slice(&a.value[..a.len]);
+        f.slope[i][..a.len].copy_from_slice(&a.slope[..a.len]);
+        f.spacing[i] = grid.spacing()[i];
+        f.first_offset[i] = grid.origin()[i] + a.index[0] as f64 * f.spacing[i] - position[i];
+        f.first_id += a.index[0] * strides[i];
+    }
+    Some(f)
+}
+
 /// Clear `out` and write the tensor product of the per-axis factors; node
 /// ids come from `grid`. Products whose value and gradient vanish are
 /// omitted.

@@ -51,6 +51,11 @@ macro_rules! basis_properties {
                 }
 
                 #[test]
+                fn tensor_factors_multiply_out_to_the_stencil((x, domain) in $cases) {
+                    check_tensor::<$dim, _>(&$basis, &x, &domain)?;
+                }
+
+                #[test]
                 fn visiting_matches_evaluation((x, domain) in $cases) {
                     check_visited::<$dim, _>(&$basis, &x, &domain)?;
                 }

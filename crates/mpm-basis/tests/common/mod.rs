@@ -624,3 +624,62 @@ where
     prop_assert_eq!(&plain.gradients, &visited.gradients);
     Ok(())
 }
+
+/// The factors of `tensor_factors` (when the basis has them) multiply out
+/// to the stencil of `evaluate`: same nodes (up to products that vanish in
+/// value and gradient), values and gradients to rounding, and node
+/// positions consistent with the offsets.
+pub fn check_tensor<const D: usize, B>(
+    basis: &B,
+    x: &SVector<f64, D>,
+    domain: &B::Domain,
+) -> Result<(), TestCaseError>
+where
+    B: BasisFunction<D>,
+    B::Mesh: TestMesh<D>,
+{
+    let mesh = B::Mesh::test_mesh();
+    let Some(factors) = basis.tensor_factors(mesh, x, domain) else {
+        return Ok(());
+    };
+    let f =
+        factors.map_err(|e| TestCaseError::fail(format!("tensor factors failed at {x:?}: {e}")))?;
+    let plain = evaluate(basis, x, domain)?;
+    let mut count = 0;
+    let total: usize = f.len.iter().product();
+    for k in 0..total {
+        let mut rest = k;
+        let (mut id, mut value) = (f.first_id, 1.0);
+        let mut gradient = SVector::<f64, D>::from_element(1.0);
+        for i in 0..D {
+            let c = rest % f.len[i];
+            rest /= f.len[i];
+            id += c * f.strides[i];
+            value *= f.value[i][c];
+            for j in 0..D {
+                gradient[j] *= if i == j { f.slope[i][c] } else { f.value[i][c] };
+            }
+        }
+        if value == 0.0 && gradient.iter().all(|g| *g == 0.0) {
+            continue;
+        }
+        count += 1;
+        prop_assert!(
+            plain.position(id).is_some(),
+            "node {} missing from the stencil",
+            id
+        );
+        prop_assert!(
+            (value - value_of(&plain, id)).abs() <= 1e-14,
+            "node {}: value",
+            id
+        );
+        prop_assert!(
+            (gradient - gradient_of(&plain, id)).norm() <= 1e-12,
+            "node {}: gradient",
+            id
+        );
+    }
+    prop_assert_eq!(count, plain.nodes.len());
+    Ok(())
+}

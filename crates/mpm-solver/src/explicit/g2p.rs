@@ -164,3 +164,38 @@ pub fn finish<const D: usize, L: IncrementalLaw, T: super::Transfer<D>>(
         })
     }
 }
+
+/// The grid fields at the point at `x`: sum-factorised when the basis has
+/// tensor factors ([`super::tensor::gather_point`]), node by node
+/// otherwise.
+///
+/// # Errors
+/// As [`super::p2g::visit_nodes`].
+#[inline(always)]
+pub fn interpolate<const D: usize, B: mpm_basis::BasisFunction<D, Domain = ()>>(
+    basis: &B,
+    mesh: &B::Mesh,
+    x: &SVector<f64, D>,
+    grid: &GridState<D>,
+    stencil: &mut mpm_basis::Stencil<D>,
+) -> Result<Gathered<D>, PointFailure> {
+    let node_count = grid.mass.len();
+    if let Some(factors) = basis.tensor_factors(mesh, x, &()) {
+        let t = factors.map_err(|e| PointFailure::Basis {
+            position: x.iter().copied().collect(),
+            source: crate::error::BasisFailure::Basis(e),
+        })?;
+        let last = t.first_id
+            + (0..D)
+                .map(|i| (t.len[i].max(1) - 1) * t.strides[i])
+                .sum::<usize>();
+        if last < node_count {
+            return Ok(super::tensor::gather_point(&t, grid));
+        }
+    }
+    let mut g = Gathered::default();
+    super::p2g::visit_nodes(basis, mesh, x, node_count, stencil, |i, w, dw| {
+        gather_node(&mut g, grid, i, w, dw);
+    })?;
+    Ok(g)
+}

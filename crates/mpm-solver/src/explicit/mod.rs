@@ -37,6 +37,7 @@ pub mod mesh;
 pub mod options;
 pub mod p2g;
 pub mod points;
+pub mod tensor;
 pub mod transfer;
 pub mod verification;
 
@@ -518,7 +519,7 @@ where
     ) -> Result<f64, (usize, PointFailure)> {
         let per = task_size(points.len());
         let (basis, mesh, grid, law) = (&self.basis, &self.mesh, &self.grid, &self.law);
-        let (alpha, node_count, m) = (self.transfer.alpha(), self.node_count, law.p_wave_modulus());
+        let (alpha, m) = (self.transfer.alpha(), law.p_wave_modulus());
         let p = points;
         let results: Vec<Result<f64, (usize, PointFailure)>> = (
             p.position.par_chunks_mut(per),
@@ -538,11 +539,8 @@ where
                 let mut signal: f64 = 0.0;
                 for k in 0..x.len() {
                     let point = task * per + k;
-                    let mut g = g2p::Gathered::default();
-                    p2g::visit_nodes(basis, mesh, &x[k], node_count, &mut stencil, |i, w, dw| {
-                        g2p::gather_node(&mut g, grid, i, w, dw);
-                    })
-                    .map_err(|e| (point, e))?;
+                    let g = g2p::interpolate(basis, mesh, &x[k], grid, &mut stencil)
+                        .map_err(|e| (point, e))?;
                     g2p::move_point(alpha, dt, &g, &mut x[k], &mut v[k]);
                     let s = g2p::finish::<D, L, T>(
                         law,
@@ -584,7 +582,7 @@ where
         self.grad_scratch.resize(n, SMatrix::zeros());
         self.cell_scratch.resize(n, 0);
         let (basis, mesh, grid) = (&self.basis, &self.mesh, &self.grid);
-        let (alpha, node_count) = (self.transfer.alpha(), self.node_count);
+        let alpha = self.transfer.alpha();
         let p = &mut *points;
         let results: Vec<Result<f64, (usize, PointFailure)>> = (
             p.position.par_chunks_mut(per),
@@ -598,11 +596,8 @@ where
                 let mut stencil = basis.new_stencil();
                 for k in 0..x.len() {
                     let point = task * per + k;
-                    let mut g = g2p::Gathered::default();
-                    p2g::visit_nodes(basis, mesh, &x[k], node_count, &mut stencil, |i, w, dw| {
-                        g2p::gather_node(&mut g, grid, i, w, dw);
-                    })
-                    .map_err(|e| (point, e))?;
+                    let g = g2p::interpolate(basis, mesh, &x[k], grid, &mut stencil)
+                        .map_err(|e| (point, e))?;
                     cells[k] = mesh.cell_of(&x[k]).unwrap_or(usize::MAX);
                     g2p::move_point(alpha, dt, &g, &mut x[k], &mut v[k]);
                     grads[k] = g.grad;

@@ -91,6 +91,14 @@ pub struct PointsView<'a, const D: usize, T> {
     pub transfer: &'a [T],
 }
 
+/// The failure of the basis at `x`.
+fn basis_failure<const D: usize>(x: &SVector<f64, D>, source: BasisFailure) -> PointFailure {
+    PointFailure::Basis {
+        position: x.iter().copied().collect(),
+        source,
+    }
+}
+
 /// Streams the supporting nodes of the point at `x` into `visit`
 /// ([`BasisFunction::for_each_node`]), checking that every node id lies
 /// below `node_count`.
@@ -107,10 +115,7 @@ pub fn visit_nodes<const D: usize, B: BasisFunction<D, Domain = ()>>(
     stencil: &mut Stencil<D>,
     mut visit: impl FnMut(usize, f64, &SVector<f64, D>),
 ) -> Result<(), PointFailure> {
-    let fail = |source| PointFailure::Basis {
-        position: x.iter().copied().collect(),
-        source,
-    };
+    let fail = |source| basis_failure(x, source);
     let mut outside = None;
     basis
         .for_each_node(mesh, x, &(), stencil, |i, w, g| {
@@ -167,6 +172,32 @@ where
         let state = &points.transfer[p];
         let stress = points.tau[p].fixed_view::<D, D>(0, 0) * points.volume0[p];
         let body = gravity * m;
+        if let Some(factors) = basis.tensor_factors(mesh, x, &()) {
+            let affine = T::affine(state);
+            if !T::TAYLOR || affine.is_some() {
+                let t = factors.map_err(|e| (p, basis_failure(x, BasisFailure::Basis(e))))?;
+                let last = t.first_id
+                    + (0..D)
+                        .map(|i| (t.len[i].max(1) - 1) * t.strides[i])
+                        .sum::<usize>();
+                if last >= node_count {
+                    return Err((
+                        p,
+                        basis_failure(
+                            x,
+                            BasisFailure::Stencil {
+                                nodes: B::MAX_NODES + 1,
+                                max: B::MAX_NODES,
+                            },
+                        ),
+                    ));
+                }
+                super::tensor::scatter_point(&t, m, v, affine.as_ref(), &stress, &body, nodes);
+                lo = lo.min(t.first_id);
+                hi = hi.max(last + 1);
+                continue;
+            }
+        }
         visit_nodes(basis, mesh, x, node_count, stencil, |i, w, g| {
             let wm = w * m;
             let carried = if T::TAYLOR {

@@ -34,6 +34,16 @@ pub trait Transfer<const D: usize>: Copy + Send + Sync + Debug {
     /// The state after the grid-to-point update, from the new velocity
     /// gradient $\nabla v_p^{n+1}$ of eq. (38).
     fn next_state(grad_v: &SMatrix<f64, D, D>) -> Self::PointState;
+
+    /// When [`Transfer::nodal_velocity`] is affine, $v_p + C_p(x_i - x_p)$,
+    /// the matrix $C_p$: the sum-factorised kernels of tensor-product bases
+    /// use it. `None` (the default) for a transfer with a Taylor term of
+    /// another form, which then takes the node-by-node path.
+    #[inline(always)]
+    fn affine(state: &Self::PointState) -> Option<SMatrix<f64, D, D>> {
+        let _ = state;
+        None
+    }
 }
 
 /// Particle-in-cell: $v_p^{n+1} = \sum_i w_{ip}\tilde v_i^{n+1}$ (eq. 35).
@@ -130,6 +140,11 @@ impl<const D: usize> Transfer<D> for Taylor {
     #[inline(always)]
     fn next_state(grad_v: &SMatrix<f64, D, D>) -> VelocityGradient<D> {
         VelocityGradient(*grad_v)
+    }
+
+    #[inline(always)]
+    fn affine(state: &VelocityGradient<D>) -> Option<SMatrix<f64, D, D>> {
+        Some(state.0)
     }
 }
 
