@@ -8,6 +8,12 @@
 //! Format: the line `MPM-CHECKPOINT 1`, one line of JSON ([`Header`]),
 //! then the material points' numbers and the predictor's increment as
 //! little-endian `f64` (counts in the header).
+//!
+//! An explicit run ([`crate::scene::explicit`]) writes the same file at
+//! each output time: `load_factor` is then the simulated time, `steps` the
+//! time steps taken, the numbers are the explicit points' state (no
+//! predictor) and `case_state` holds the output number, the work of the
+//! point forces, the initial energies and the energy scale of the drift.
 
 use std::path::Path;
 

@@ -2,13 +2,13 @@
 //!
 //! ```text
 //! mpm list
-//! mpm run scene.toml [--set key=value ...] [--out DIR]
-//! mpm run --case column [--set key=value ...] [--out DIR]
+//! mpm run scene.toml [--set key=value ...] [--out DIR] [--threads N]
+//! mpm run --case column [--set key=value ...] [--out DIR] [--threads N]
 //! ```
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow};
 use clap::{Parser, Subcommand};
 use mpm_cases::CasesError;
 use mpm_cases::cases;
@@ -20,7 +20,7 @@ use mpm_solver::SolverError;
 #[command(
     name = "mpm",
     version,
-    about = "Implicit material point method: benchmark cases and scene files"
+    about = "Material point method (implicit quasi-static and explicit dynamic): benchmark cases and scene files"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -61,6 +61,10 @@ enum Command {
         /// eigenvalue studies in other tools).
         #[arg(long)]
         export_tangent: bool,
+        /// Run on a pool of N threads (default: rayon's, one per core or
+        /// RAYON_NUM_THREADS).
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+        threads: Option<u16>,
     },
 }
 
@@ -84,7 +88,7 @@ fn run_cli(cli: Cli) -> Result<()> {
             }
             writeln!(
                 text,
-                "\nscene files without a `case` key describe a whole problem ([mesh], [[material]], [[body]], [[boundary]], [[load]], [[curve]], [solver], [output]): see docs/src/guide/scenes.md and scenes/"
+                "\nscene files without a `case` key describe a whole problem ([mesh], [[material]], [[body]], [[boundary]], [[load]], [[curve]], [solver], [output]), quasi-static or, with [solver] kind = \"explicit\", in time: see docs/src/guide/scenes.md and scenes/"
             )?;
             writeln!(
                 text,
@@ -114,6 +118,7 @@ fn run_cli(cli: Cli) -> Result<()> {
             resume,
             stop_after,
             export_tangent,
+            threads,
         } => {
             let (text, origin) = match &scene {
                 Some(path) => (
@@ -153,24 +158,33 @@ fn run_cli(cli: Cli) -> Result<()> {
                     .map(PathBuf::from)
                     .unwrap_or_default(),
             };
-            let result = if is_scene {
-                mpm_cases::scene::run_file(&text, &origin, &set, &session)
-                    .map_err(anyhow::Error::from)
+            let case = if is_scene {
+                None
             } else {
-                match cases::find(&name) {
-                    Some(case) => {
-                        (case.run)(&text, &origin, &set, &session).map_err(anyhow::Error::from)
-                    }
-                    None => bail!(
+                Some(cases::find(&name).ok_or_else(|| {
+                    anyhow!(
                         "unknown case `{name}`; cases: {}",
                         cases::ALL
                             .iter()
                             .map(|c| c.name)
                             .collect::<Vec<_>>()
                             .join(", ")
-                    ),
-                }
+                    )
+                })?)
             };
+            let run = || match case {
+                None => mpm_cases::scene::run_file(&text, &origin, &set, &session),
+                Some(case) => (case.run)(&text, &origin, &set, &session),
+            };
+            let result = match threads {
+                Some(n) => rayon::ThreadPoolBuilder::new()
+                    .num_threads(usize::from(n))
+                    .build()
+                    .context("cannot start the thread pool")?
+                    .install(run),
+                None => run(),
+            }
+            .map_err(anyhow::Error::from);
             match result {
                 Err(e) => match e.downcast_ref::<CasesError>() {
                     Some(CasesError::Solver(SolverError::Stopped { step, load_factor })) => {

@@ -82,6 +82,9 @@ pub struct Snapshot {
     pub position: Vec<[f64; 3]>,
     /// Total displacement, padded to 3D.
     pub displacement: Vec<[f64; 3]>,
+    /// Velocity, padded to 3D (explicit runs; empty for the quasi-static
+    /// solver).
+    pub velocity: Vec<[f64; 3]>,
     /// Cauchy stress, row-major 3×3.
     pub sigma: Vec<[f64; 9]>,
     /// Deformation gradient, row-major 3×3.
@@ -162,6 +165,7 @@ impl Snapshot {
             load_factor,
             position: points.position.iter().map(pad).collect(),
             displacement: points.displacement.iter().map(pad).collect(),
+            velocity: Vec::new(),
             sigma: points.sigma.iter().map(flat).collect(),
             f: points.f.iter().map(flat).collect(),
             volume: points.volume.clone(),

@@ -6,7 +6,7 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use mpm_solver::{ObserverError, SolverError, StepReport};
@@ -18,7 +18,7 @@ use crate::checkpoint;
 use crate::output::CellMesh;
 use crate::run::{RunControl, RunOutput, Snapshot};
 use crate::variant::Variant;
-use crate::writer::{RunWriter, Summary};
+use crate::writer::{ExplicitSummary, RunWriter, Summary};
 
 /// Where a run writes, whether it resumes, and the scene file it came from.
 #[derive(Debug, Clone, Default)]
@@ -105,6 +105,8 @@ pub struct Observer<const D: usize, M> {
     parameters: Value,
     stop_after: Option<usize>,
     steps: usize,
+    /// When the progress display was last updated (explicit runs).
+    last_shown: Option<Instant>,
 }
 
 impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
@@ -131,6 +133,7 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
             parameters,
             stop_after: None,
             steps: 0,
+            last_shown: None,
         }
     }
 
@@ -197,6 +200,110 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
         self.writer.dir()
     }
 
+    /// Shows the progress of an explicit run in simulated time.
+    pub fn show_time(&mut self) {
+        if self.plain {
+            return;
+        }
+        if let Ok(style) =
+            ProgressStyle::with_template("{elapsed_precise} [{bar:30}] time {percent:>3}% {msg}")
+        {
+            self.bar.set_style(style.progress_chars("=> "));
+        }
+    }
+
+    /// Shows time step `step` of an explicit run (at most ten times a
+    /// second; nothing on a plain output, which gets a line per output).
+    pub fn explicit_step(&mut self, time: f64, end_time: f64, step: usize, dt: f64) {
+        if self.plain
+            || self
+                .last_shown
+                .is_some_and(|t| t.elapsed() < Duration::from_millis(100))
+        {
+            return;
+        }
+        self.last_shown = Some(Instant::now());
+        self.bar
+            .set_position((time / end_time * 1000.0).round() as u64);
+        self.bar
+            .set_message(format!("t = {time:.4e} s, step {step}, Δt = {dt:.3e} s"));
+    }
+
+    /// Writes output `index` of an explicit run (the VTU files and, when
+    /// the snapshot carries one, the checkpoint), shows it, and stops the
+    /// run after `stop_after` outputs of this session.
+    ///
+    /// # Errors
+    /// [`SolverError::Observer`] for an output that cannot be written;
+    /// [`SolverError::Stopped`] after `stop_after` outputs (`step` is the
+    /// output number, `load_factor` the time).
+    pub fn explicit_output(
+        &mut self,
+        index: usize,
+        time: f64,
+        end_time: f64,
+        steps: usize,
+        snap: &Snapshot,
+    ) -> Result<(), SolverError> {
+        let line = format!("output {index} at t = {time:.6e} s: {steps} time steps");
+        if self.plain {
+            eprintln!("{line}");
+        } else {
+            self.bar
+                .set_position((time / end_time * 1000.0).round() as u64);
+        }
+        self.writer
+            .output(index, time, snap)
+            .map_err(observer_error)?;
+        if let Some(c) = &snap.checkpoint {
+            checkpoint::write(
+                self.writer.dir(),
+                &self.case,
+                self.parameters.clone(),
+                c,
+                self.writer.state(),
+            )
+            .map_err(observer_error)?;
+        }
+        if index == 0 {
+            return Ok(());
+        }
+        self.steps += 1;
+        if self.stop_after.is_some_and(|n| self.steps >= n) && time < end_time {
+            self.bar.finish_and_clear();
+            return Err(SolverError::Stopped {
+                step: index,
+                load_factor: time,
+            });
+        }
+        Ok(())
+    }
+
+    /// Writes `summary.json` of an explicit run and prints its digest.
+    ///
+    /// # Errors
+    /// I/O and serialisation errors of `summary.json`.
+    pub fn finish_explicit<P: Serialize>(
+        self,
+        summary: ExplicitSummary<P>,
+    ) -> Result<(), CasesError> {
+        self.bar.finish_and_clear();
+        self.writer.explicit_summary(&summary)?;
+        println!(
+            "{} [explicit {} {} {}]: {} points, {} time steps to t = {}, energy drift {:.3e}, {:.3} s",
+            summary.case,
+            summary.basis,
+            summary.transfer.name(),
+            summary.locking,
+            summary.material_points,
+            summary.time_steps,
+            shown(summary.end_time),
+            summary.energy_drift,
+            summary.wall_time_s,
+        );
+        Ok(())
+    }
+
     /// Writes `summary.json` and prints its one-line digest.
     ///
     /// # Errors
@@ -224,6 +331,12 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
         );
         Ok(())
     }
+}
+
+/// `x` rounded to 12 significant digits, for messages: a time reached by
+/// a sum of fixed steps (29.999999999997215) reads as the time it is (30).
+pub fn shown(x: f64) -> f64 {
+    format!("{x:.11e}").parse().unwrap_or(x)
 }
 
 /// An output error as the solver's observer reports it.

@@ -158,8 +158,14 @@ named_enum!(
         /// F-patch on simplices split from tri6/tet10 parents
         /// (`mpm_solver::FPatch`, Wang et al. 2021).
         FPatch => "fpatch",
+        /// The explicit solver's cell-averaged dilatation
+        /// (`mpm_solver::CellAveraged`, MPoint notes eqs. 47–53).
+        CellAveraged => "cell_averaged",
     }
 );
+
+/// Why the implicit solver refuses `locking = cell_averaged`.
+pub const CELL_AVERAGED_IMPLICIT: &str = "locking = cell_averaged is the explicit solver's dilatation averaging (solver kind = \"explicit\"); the implicit solver takes fbar (grids) or fpatch (simplex patches)";
 
 /// A complete MPM variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -202,6 +208,7 @@ impl Variant {
             LockingKind::FBar => Err(format!(
                 "locking = fbar averages over grid cells and applies to regular grids; on {mesh} use locking = fpatch"
             )),
+            LockingKind::CellAveraged => Err(CELL_AVERAGED_IMPLICIT.into()),
         }
     }
 
@@ -274,6 +281,7 @@ pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
     }
     match variant.locking {
         LockingKind::None => {}
+        LockingKind::CellAveraged => return Err(CELL_AVERAGED_IMPLICIT.into()),
         LockingKind::FPatch => {
             return Err("locking = fpatch averages over the patches of split tri6/tet10 parents and applies to simplex meshes; on a regular grid use locking = fbar".into());
         }

@@ -37,6 +37,8 @@ pub struct RunWriter<const D: usize, M> {
 pub enum Field {
     /// Total displacement (`displacement`).
     Displacement,
+    /// Velocity (`velocity`; explicit runs).
+    Velocity,
     /// Cauchy stress (`cauchy_stress`).
     Stress,
     /// Deformation gradient (`deformation_gradient`).
@@ -54,8 +56,9 @@ pub enum Field {
 
 impl Field {
     /// Every field.
-    pub const ALL: [Field; 7] = [
+    pub const ALL: [Field; 8] = [
         Field::Displacement,
+        Field::Velocity,
         Field::Stress,
         Field::DeformationGradient,
         Field::Volume,
@@ -128,6 +131,48 @@ pub struct Summary<P: Serialize> {
     #[serde(flatten)]
     pub results: serde_json::Map<String, serde_json::Value>,
     /// The parameters the case ran with.
+    pub parameters: P,
+}
+
+/// What `summary.json` of an explicit run holds.
+#[derive(Debug, Clone, Serialize)]
+pub struct ExplicitSummary<P: Serialize> {
+    /// Case name (`scene`).
+    pub case: String,
+    /// `explicit`.
+    pub solver: String,
+    /// Basis.
+    pub basis: crate::variant::BasisKind,
+    /// Velocity transfer.
+    pub transfer: crate::scene::format::TransferKind,
+    /// Its FLIP fraction α.
+    pub alpha: f64,
+    /// Dilatation treatment (`none` or `cell_averaged`).
+    pub locking: crate::variant::LockingKind,
+    /// Number of material points.
+    pub material_points: usize,
+    /// Time steps taken.
+    pub time_steps: usize,
+    /// Simulated time reached (s).
+    pub end_time: f64,
+    /// Outputs written, the initial state included.
+    pub outputs: usize,
+    /// Solver wall time in seconds (file output excluded).
+    pub wall_time_s: f64,
+    /// Wall time per stage of this session (`p2g`, `grid`, `g2p`), seconds.
+    pub stage_times_s: serde_json::Value,
+    /// Energies at t = 0 (`kinetic`, `strain`, `gravitational`,
+    /// `external_work`, `total`).
+    pub initial_energies: serde_json::Value,
+    /// Energies at the end.
+    pub final_energies: serde_json::Value,
+    /// (total(end) − total(0)) / the largest kinetic + strain energy of the
+    /// outputs.
+    pub energy_drift: f64,
+    /// Scene results (bodies, probes, the PNG).
+    #[serde(flatten)]
+    pub results: serde_json::Map<String, serde_json::Value>,
+    /// The parameters the run was started with.
     pub parameters: P,
 }
 
@@ -247,7 +292,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
         }
         let last = report.lambda1 >= 1.0 - 1e-12;
         if (step + 1).is_multiple_of(self.options.every.max(1)) || last {
-            self.write_vtu(step, report, snap)?;
+            self.write_vtu(step, report.lambda1, snap)?;
         }
         let mut row = vec![
             CsvValue::from(step),
@@ -290,13 +335,16 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
         self.iterations.write(&self.dir.join("iterations.csv"))
     }
 
-    /// The VTU files (points and active grid) and the tangent of one step.
-    fn write_vtu(
-        &mut self,
-        step: usize,
-        report: &StepReport<D>,
-        snap: &Snapshot,
-    ) -> Result<(), CasesError> {
+    /// Writes the VTU files (points and active grid) of output `index` of
+    /// an explicit run at simulated time `time` (the series' time); no
+    /// step tables.
+    pub fn output(&mut self, index: usize, time: f64, snap: &Snapshot) -> Result<(), CasesError> {
+        self.write_vtu(index, time, snap)
+    }
+
+    /// The VTU files (points and active grid) and the tangent of one step,
+    /// at `time` in the series (the load factor, or the simulated time).
+    fn write_vtu(&mut self, step: usize, time: f64, snap: &Snapshot) -> Result<(), CasesError> {
         let name = format!("points_{step:04}.vtu");
         let path = self.dir.join(&name);
         let mut vtu = UnstructuredGrid::new(&snap.position)?;
@@ -304,6 +352,9 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
         let has = |f: Field| self.options.fields.contains(&f);
         if has(Field::Displacement) {
             vtu.point_data("displacement", Values::vectors(&snap.displacement))?;
+        }
+        if has(Field::Velocity) && !snap.velocity.is_empty() {
+            vtu.point_data("velocity", Values::vectors(&snap.velocity))?;
         }
         if has(Field::Stress) {
             vtu.point_data("cauchy_stress", Values::tensors(&snap.sigma))?;
@@ -332,7 +383,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
             }
         }
         vtu.write(&path)?;
-        self.points.push(report.lambda1, &path)?;
+        self.points.push(time, &path)?;
 
         if let Some(k) = &snap.tangent {
             let path = self.dir.join(format!("tangent_{step:04}.mtx"));
@@ -340,7 +391,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
         }
         let grid_path = self.dir.join(format!("grid_{step:04}.vtu"));
         self.write_active_grid(&grid_path, snap)?;
-        self.cells.push(report.lambda1, &grid_path)
+        self.cells.push(time, &grid_path)
     }
 
     /// The mesh cells holding material points.
@@ -354,6 +405,14 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
 
     /// Writes `summary.json`.
     pub fn summary<P: Serialize>(&self, summary: &Summary<P>) -> Result<(), CasesError> {
+        write_summary(&self.dir.join("summary.json"), summary)
+    }
+
+    /// Writes `summary.json` of an explicit run.
+    pub fn explicit_summary<P: Serialize>(
+        &self,
+        summary: &ExplicitSummary<P>,
+    ) -> Result<(), CasesError> {
         write_summary(&self.dir.join("summary.json"), summary)
     }
 }

@@ -21,7 +21,7 @@ const FOOTING_QUICK_MESH: &str = "mesh.coordinates=[[0.0, 0.25, 0.8, 2.1, 5.0], 
 fn run2(text: &str, overrides: &[&str]) -> (Problem<2>, RunOutput<2>) {
     let set: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let (scene, src) = scene::parse(text, "scene.toml", &set).unwrap();
-    let problem = Problem::<2>::build(&scene, &src, scene.solver.basis.padding()).unwrap();
+    let problem = Problem::<2>::build(&scene, &src, scene.solver.padding()).unwrap();
     let out = scene::run(&problem, &RunControl::default(), |_, _, _| Ok(())).unwrap();
     (problem, out)
 }
@@ -68,8 +68,8 @@ fn refusal(text: &str) -> String {
     let built =
         scene::parse(text, "bad.toml", &[]).and_then(|(scene, src)| {
             match scene::dimension(&scene, &src)? {
-                2 => Problem::<2>::build(&scene, &src, scene.solver.basis.padding()).map(|_| ()),
-                _ => Problem::<3>::build(&scene, &src, scene.solver.basis.padding()).map(|_| ()),
+                2 => Problem::<2>::build(&scene, &src, scene.solver.padding()).map(|_| ()),
+                _ => Problem::<3>::build(&scene, &src, scene.solver.padding()).map(|_| ()),
             }
         });
     match built {
@@ -479,6 +479,97 @@ fn malformed_scenes_are_refused_with_a_located_message() {
             "[[node_set]]\nname = \"s\"\naround = \"b\"\n\n[output]\nreaction = [{ name = \"r\", set = \"s\" }]\n\n[solver]",
             "bad.toml:31:33: node set `s` follows a body (its nodes change every step)",
         ),
+        // The [solver] keys of one kind are refused with the other.
+        (
+            "steps = 2",
+            "steps = 2\nend_time = 1.0",
+            "bad.toml:28:12: solver `end_time` applies to kind = \"explicit\" (the implicit solver steps the load factor: `steps`, `max_increment`, `min_increment`)",
+        ),
+        (
+            "steps = 2",
+            "steps = 2\nlocking = \"cell_averaged\"",
+            "bad.toml:28:11: locking = cell_averaged is the explicit solver's dilatation averaging",
+        ),
+        (
+            "material = \"m\"",
+            "material = \"m\"\nvelocity = [1.0, 0.0]",
+            "bad.toml:16:12: a body's `velocity` (its initial velocity) applies to the explicit solver",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"",
+            "bad.toml:27:8: kind = \"explicit\" needs `end_time`, the simulated time to reach (s)",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\nsteps = 2",
+            "bad.toml:29:9: solver `steps` applies to the implicit solver; kind = \"explicit\" steps in time (`end_time`, `cfl` or `time_step`)",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\ntolerance = 1e-6",
+            "bad.toml:29:13: solver `tolerance` applies to the implicit solver",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\nformulation = \"ul\"",
+            "bad.toml:29:15: solver `formulation` applies to the implicit solver",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\nbasis = \"gimp\"",
+            "bad.toml:29:9: basis = gimp needs a domain per point and a rule that updates it in time, which the explicit solver does not have yet",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\nlocking = \"fbar\"",
+            "bad.toml:29:11: locking = fbar is an implicit treatment; the explicit solver takes locking = \"none\" or \"cell_averaged\"",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = -1.0",
+            "bad.toml:28:12: solver `end_time` must be positive, got -1",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\ncfl = 0.5\ntime_step = 0.01",
+            "bad.toml:30:13: give solver `cfl` or `time_step`, not both",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\ncfl = 1.5",
+            "bad.toml:29:7: solver `cfl` must lie in (0, 1], got 1.5",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\ntime_step = 0.0",
+            "bad.toml:29:13: solver `time_step` must be positive, got 0",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\ntransfer = \"blend\"",
+            "bad.toml:29:12: transfer = \"blend\" needs `alpha`, its FLIP fraction in [0, 1]",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\nalpha = 0.5",
+            "bad.toml:29:9: solver `alpha` applies to transfer = \"blend\" (transfer = \"flip\" has α = 1)",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\ntransfer = \"blend\"\nalpha = 1.5",
+            "bad.toml:30:9: solver `alpha` must lie in [0, 1], got 1.5",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\ntransfer = \"apic\"",
+            "bad.toml:29:12: unknown variant `apic`, expected one of `pic`, `flip`, `blend`, `tpic`, `tflip`",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\noutput_interval = 0.0",
+            "bad.toml:29:19: solver `output_interval` must be positive, got 0",
+        ),
     ];
     let mut wrong = Vec::new();
     for (from, to, expected) in cases {
@@ -488,6 +579,96 @@ fn malformed_scenes_are_refused_with_a_located_message() {
         if !message.contains(expected) {
             wrong.push(format!(
                 "for `{to}`\nexpected: {expected}\n     got: {message}"
+            ));
+        }
+    }
+    // The same scene run by the explicit solver: what it cannot take
+    // outside [solver], each refused where it is.
+    let explicit = VALID.replacen("steps = 2", "kind = \"explicit\"\nend_time = 0.1", 1);
+    let explicit_cases: &[(&str, &str, &str)] = &[
+        (
+            "kind = \"fixed\"",
+            "kind = \"displacement\"\ndisplacement = { y = 0.1 }",
+            "bad.toml:20:8: a non-zero displacement follows the implicit solver's load factor; the explicit solver holds nodes (fixed, roller, a zero displacement) or moves them at a constant velocity (kind = \"velocity\")",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"velocity\"",
+            "bad.toml:20:8: kind = velocity needs `velocity = { x = …, y = … }` (m/s)",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"fixed\"\nvelocity = { x = 1.0 }",
+            "bad.toml:20:8: `velocity` applies to kind = velocity, not fixed",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"velocity\"\nvelocity = { z = 1.0 }",
+            "bad.toml:21:12: a 2D scene has no z component",
+        ),
+        (
+            "[[boundary]]\nset = \"y_min\"\nkind = \"fixed\"",
+            "[[node_set]]\nname = \"s\"\naround = \"b\"\n\n[[boundary]]\nset = \"s\"\nkind = \"fixed\"",
+            "bad.toml:23:7: node set `s` follows a body; the explicit solver's conditions hold fixed sets of nodes",
+        ),
+        (
+            "acceleration = [0.0, -10.0]",
+            "acceleration = [0.0, -10.0]\nbody = \"b\"",
+            "bad.toml:25:8: the explicit solver's gravity acts on every body: leave out `body`",
+        ),
+        (
+            "acceleration = [0.0, -10.0]",
+            "acceleration = [0.0, -10.0]\ncurve = \"c\"\n\n[[curve]]\nname = \"c\"\npoints = [[0.0, 0.0], [1.0, 1.0]]",
+            "bad.toml:25:9: load curves follow the implicit solver's load factor; the explicit solver's loads are constant in time",
+        ),
+        (
+            "kind = \"gravity\"\nacceleration = [0.0, -10.0]",
+            "kind = \"manufactured\"\nfield = \"annulus_torsion\"\nparameters = { inner_radius = 0.75, outer_radius = 1.25, alpha = 0.1 }",
+            "bad.toml:23:8: a manufactured load balances a quasi-static solution; the explicit solver does not take it",
+        ),
+        (
+            "cells = [2, 2]",
+            "cells = [2, 2]\n\n[mesh.motion]\nkind = \"stretch\"\naxis = \"y\"\nextension = 1.0\ndriven = \"y_max\"",
+            "bad.toml:7:8: a moving mesh follows the implicit solver's load factor",
+        ),
+        (
+            "[mesh]",
+            "[mesh]\nkind = \"simplex\"",
+            "bad.toml:28:8: kind = \"explicit\" runs on regular grids ([mesh] kind = \"grid\")",
+        ),
+        (
+            "density = 1.0",
+            "density = 0.0",
+            "bad.toml:11:11: the explicit solver needs a positive density",
+        ),
+        (
+            "[[body]]",
+            "[[material]]\nname = \"m2\"\nmodel = \"hencky\"\nyoungs_modulus = 2e6\npoisson_ratio = 0.3\ndensity = 1.0\n\n[[body]]",
+            "bad.toml:14:8: material `m2` differs from `m` in its model or parameters: an explicit scene runs one law for now (its materials may differ in density only)",
+        ),
+        (
+            "material = \"m\"",
+            "material = \"m\"\nvelocity = [1.0, 0.0, 0.0]",
+            "bad.toml:16:12: body `velocity` has 3 components; the scene is 2D",
+        ),
+        (
+            "[solver]",
+            "[output]\nreaction = [{ name = \"r\", set = \"y_min\" }]\n\n[solver]",
+            "bad.toml:27:22: reaction outputs are the implicit solver's nodal reactions; the explicit solver does not compute them",
+        ),
+        (
+            "[solver]",
+            "[output]\nevery = 2\n\n[solver]",
+            "bad.toml:27:9: output `every` counts the implicit solver's load steps",
+        ),
+    ];
+    for (from, to, expected) in explicit_cases {
+        assert!(explicit.contains(from), "{from}");
+        let text = explicit.replacen(from, to, 1);
+        let message = refusal(&text);
+        if !message.contains(expected) {
+            wrong.push(format!(
+                "for `{to}` (explicit)\nexpected: {expected}\n     got: {message}"
             ));
         }
     }
@@ -592,14 +773,14 @@ proptest! {
     fn mutated_scenes_never_panic(text in mutated()) {
         if let Ok((scene, src)) = scene::parse(&text, "m.toml", &[]) {
             let built = match scene::dimension(&scene, &src) {
-                Ok(2) => Problem::<2>::build(&scene, &src, scene.solver.basis.padding()).map(|p| p.len()),
-                Ok(_) => Problem::<3>::build(&scene, &src, scene.solver.basis.padding()).map(|p| p.len()),
+                Ok(2) => Problem::<2>::build(&scene, &src, scene.solver.padding()).map(|p| p.len()),
+                Ok(_) => Problem::<3>::build(&scene, &src, scene.solver.padding()).map(|p| p.len()),
                 Err(e) => Err(e),
             };
             if let Ok(points) = built {
                 prop_assert!(points > 0);
                 // What builds also runs to an answer or a typed error.
-                if let Ok(problem) = Problem::<2>::build(&scene, &src, scene.solver.basis.padding()) {
+                if let Ok(problem) = Problem::<2>::build(&scene, &src, scene.solver.padding()) {
                     let _ = scene::run(&problem, &RunControl::default(), |_, _, _| Ok(()));
                 }
             }
@@ -731,6 +912,9 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/wang2021_vane_full.toml"),
         include_str!("../../../scenes/wang2021_indentation.toml"),
         include_str!("../../../scenes/wang2021_notched_plate.toml"),
+        include_str!("../../../scenes/explicit_bar.toml"),
+        include_str!("../../../scenes/explicit_disks.toml"),
+        include_str!("../../../scenes/explicit_cube.toml"),
     ]
     .join("\n");
     let mut keys = Vec::new();

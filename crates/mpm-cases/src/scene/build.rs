@@ -18,10 +18,11 @@ use crate::CasesError;
 use crate::material::{LawVisitor, MaterialModel, MaterialParams, dispatch_law};
 use crate::run::HistoryOutput;
 use crate::scene_file::SceneSource;
-use crate::variant::Variant;
+use crate::variant::{BasisKind, LockingKind, Variant};
 
 use super::format::{
     BoundaryKind, Field, LinearKind, LoadKind, MeshKind, MotionKind, Placement, RegionSpec, Scene,
+    SolverKind, SolverSpec, TransferKind,
 };
 use super::region::{Region, point};
 
@@ -258,6 +259,38 @@ pub struct CurvedForces<const D: usize> {
     pub force: Vec<SVector<f64, D>>,
 }
 
+/// What a scene with `[solver] kind = "explicit"` adds to its problem:
+/// the time stepping, the transfer, the constant loads and the velocity
+/// fixities. The implicit parts of the [`Problem`] (load stepping, Newton
+/// controls, `constraints`, `body_force`, `point_forces`) are not used by
+/// an explicit run.
+#[derive(Debug, Clone)]
+pub struct ExplicitSetup<const D: usize> {
+    /// The simulated time the run ends at (s).
+    pub end_time: f64,
+    /// Simulated time between outputs (s).
+    pub output_interval: f64,
+    /// The time step rule.
+    pub time_step: mpm_solver::TimeStep,
+    /// The velocity transfer.
+    pub transfer: TransferKind,
+    /// Its FLIP fraction α (0 for `pic` and `tpic`, 1 for `flip` and
+    /// `tflip`, `alpha` for `blend`).
+    pub alpha: f64,
+    /// `LockingKind::None` or `LockingKind::CellAveraged`.
+    pub locking: LockingKind,
+    /// Gravitational acceleration on every point (the sum of the gravity
+    /// loads).
+    pub gravity: SVector<f64, D>,
+    /// Zero-velocity fixities of the fixed, roller and zero-displacement
+    /// conditions, and the constant velocities of `velocity` conditions.
+    pub fixities: mpm_solver::VelocityFixities,
+    /// Initial velocity of every point.
+    pub velocity: Vec<SVector<f64, D>>,
+    /// Constant point forces (point loads and tractions), per point index.
+    pub point_forces: Vec<(usize, SVector<f64, D>)>,
+}
+
 /// A scene ready to run.
 #[derive(Debug, Clone)]
 pub struct Problem<const D: usize> {
@@ -314,6 +347,10 @@ pub struct Problem<const D: usize> {
     pub fields: Vec<Field>,
     /// Write a PNG of the final state.
     pub png: bool,
+    /// The explicit solver's setup, for a scene with `[solver] kind =
+    /// "explicit"` (run it with [`super::run_explicit`]); `None` for the
+    /// implicit solver.
+    pub explicit: Option<ExplicitSetup<D>>,
 }
 
 /// A reaction history of `[[output.reaction]]`: the sum of the reactions
@@ -466,8 +503,8 @@ impl LawVisitor for Validate {
 }
 
 impl<const D: usize> Problem<D> {
-    /// Builds the scene for a basis that needs `basis_padding` cells of
-    /// padding.
+    /// Builds the scene with at least `basis_padding` cells of padding
+    /// (and at least what the scene's basis needs, [`SolverSpec::padding`]).
     ///
     /// # Errors
     /// [`CasesError::Scene`] (or [`CasesError::Override`]) at the value
@@ -497,16 +534,34 @@ impl<const D: usize> Problem<D> {
         mesh_dir: &std::path::Path,
     ) -> Result<Self, CasesError> {
         let check = Check { src };
+        let solver = &scene.solver;
+        let explicit_keys = solver_keys(solver, src)?;
+        let explicit = explicit_keys.is_some();
         let variant = Variant {
-            basis: scene.solver.basis,
-            formulation: scene.solver.formulation,
-            locking: scene.solver.locking,
-            domain_update: scene.solver.domain_update,
-            gimp_volume: scene.solver.gimp_volume,
+            basis: solver.basis(),
+            formulation: *solver.formulation.get_ref(),
+            locking: *solver.locking.get_ref(),
+            domain_update: *solver.domain_update.get_ref(),
+            gimp_volume: *solver.gimp_volume.get_ref(),
         };
+        let basis_padding = basis_padding.max(solver.padding());
 
         // Mesh.
         let m = &scene.mesh;
+        if explicit {
+            if m.kind != MeshKind::Grid {
+                return Err(src.at(
+                    &solver.kind,
+                    "kind = \"explicit\" runs on regular grids ([mesh] kind = \"grid\"); simplex, annulus and Gmsh meshes take the implicit solver",
+                ));
+            }
+            if let Some(motion) = &m.motion {
+                return Err(src.at(
+                    &motion.kind,
+                    "a moving mesh follows the implicit solver's load factor; the explicit solver's grid stays where it is (prescribe velocities with [[boundary]] kind = \"velocity\")",
+                ));
+            }
+        }
         let annulus_key = [
             m.inner_radius.as_ref().map(Spanned::span),
             m.outer_radius.as_ref().map(Spanned::span),
@@ -794,12 +849,35 @@ impl<const D: usize> Problem<D> {
             if density < 0.0 {
                 return Err(src.at(&spec.density, "density must be non-negative"));
             }
+            if explicit && density <= 0.0 {
+                return Err(src.at(
+                    &spec.density,
+                    "the explicit solver needs a positive density (the points' masses set the wave speed and the time step)",
+                ));
+            }
             let mut params = MaterialParams {
                 youngs_modulus: spec.youngs_modulus,
                 poisson_ratio: spec.poisson_ratio,
                 yield_stress: spec.yield_stress,
                 hardening: spec.hardening,
             };
+            if explicit
+                && let Some(first) = scene.materials.first()
+                && (first.model != spec.model
+                    || first.youngs_modulus != spec.youngs_modulus
+                    || first.poisson_ratio != spec.poisson_ratio
+                    || first.yield_stress != spec.yield_stress
+                    || first.hardening != spec.hardening)
+            {
+                return Err(src.at(
+                    &spec.name,
+                    format!(
+                        "material `{}` differs from `{}` in its model or parameters: an explicit scene runs one law for now (its materials may differ in density only)",
+                        spec.name.get_ref(),
+                        first.name.get_ref()
+                    ),
+                ));
+            }
             if spec.model != MaterialModel::VonMises && spec.yield_stress.is_some() {
                 return Err(src.at(
                     &spec.name,
@@ -854,6 +932,7 @@ impl<const D: usize> Problem<D> {
         unique_names(scene.bodies.iter().map(|b| &b.name), "body", src)?;
         let mut regions: Vec<Option<Region<D>>> = Vec::new();
         let mut problem_points = Points::<D>::default();
+        let mut initial_velocity: Vec<SVector<f64, D>> = Vec::new();
         let mut bodies = Vec::new();
         let mut element_owner: Vec<Option<usize>> = match &mesh {
             SceneMesh::Simplex(sm) => vec![None; sm.element_count()],
@@ -1047,6 +1126,17 @@ impl<const D: usize> Problem<D> {
                 problem_points.material.push(material as u32);
                 problem_points.body.push(b as u32);
             }
+            let v0 = match &spec.velocity {
+                Some(v) if !explicit => {
+                    return Err(src.at(
+                        v,
+                        "a body's `velocity` (its initial velocity) applies to the explicit solver ([solver] kind = \"explicit\"); the implicit solver is quasi-static",
+                    ));
+                }
+                Some(v) => point::<D>(v, "body `velocity`", src)?,
+                None => SVector::zeros(),
+            };
+            initial_velocity.resize(end, v0);
             regions.push(region);
             bodies.push(BuiltBody {
                 name: spec.name.get_ref().clone(),
@@ -1173,11 +1263,31 @@ impl<const D: usize> Problem<D> {
         let mut following = Vec::new();
         let initial_nodes: Vec<SVector<f64, D>> =
             (0..mesh.node_count()).map(node_position).collect();
+        let mut velocity_dofs: Vec<Option<f64>> = vec![None; mesh.node_count() * D];
         for spec in &scene.boundaries {
             let gradient = match &spec.gradient {
                 Some(g) => Some(gradient_of::<D>(g, src)?),
                 None => None,
             };
+            let kind = *spec.kind.get_ref();
+            if spec.velocity.is_some() && kind != BoundaryKind::Velocity {
+                return Err(src.at(
+                    &spec.kind,
+                    format!(
+                        "`velocity` applies to kind = velocity, not {}",
+                        boundary_kind_name(kind)
+                    ),
+                ));
+            }
+            if explicit && following_sets.contains_key(spec.set.get_ref()) {
+                return Err(src.at(
+                    &spec.set,
+                    format!(
+                        "node set `{}` follows a body; the explicit solver's conditions hold fixed sets of nodes",
+                        spec.set.get_ref()
+                    ),
+                ));
+            }
             if let Some(points) = following_sets.get(spec.set.get_ref()) {
                 let (displacement, gradient, curve) = match spec.kind.get_ref() {
                     BoundaryKind::Fixed => {
@@ -1236,6 +1346,8 @@ impl<const D: usize> Problem<D> {
             let mut prescribe = |component: usize, value: f64, curve: usize| {
                 for &v in nodes {
                     dofs[v * D + component] = Some((value, curve as u16));
+                    // Explicit runs: a held node (explicit displacements are zero).
+                    velocity_dofs[v * D + component] = Some(0.0);
                 }
             };
             let not_here = |what: &str, kind: &str| {
@@ -1291,6 +1403,14 @@ impl<const D: usize> Problem<D> {
                             ));
                         }
                     };
+                    if explicit
+                        && (gradient.is_some() || values.iter().flatten().any(|u| *u != 0.0))
+                    {
+                        return Err(src.at(
+                            &spec.kind,
+                            "a non-zero displacement follows the implicit solver's load factor; the explicit solver holds nodes (fixed, roller, a zero displacement) or moves them at a constant velocity (kind = \"velocity\")",
+                        ));
+                    }
                     match &gradient {
                         None => {
                             for (i, v) in values.iter().take(D).enumerate() {
@@ -1308,6 +1428,34 @@ impl<const D: usize> Problem<D> {
                                         + (0..D).map(|j| g[(i, j)] * x[j]).sum::<f64>();
                                     dofs[v * D + i] = Some((u, curve as u16));
                                 }
+                            }
+                        }
+                    }
+                }
+                BoundaryKind::Velocity if explicit => {
+                    for (key, present) in [
+                        ("displacement", spec.displacement.is_some()),
+                        ("gradient", spec.gradient.is_some()),
+                        ("curve", spec.curve.is_some()),
+                    ] {
+                        if present {
+                            return Err(src.at(
+                                &spec.kind,
+                                format!("`{key}` applies to kind = displacement, not velocity"),
+                            ));
+                        }
+                    }
+                    let Some(v) = &spec.velocity else {
+                        return Err(src.at(
+                            &spec.kind,
+                            "kind = velocity needs `velocity = { x = …, y = … }` (m/s)",
+                        ));
+                    };
+                    let values = axes_of::<D>(v, "velocity", src)?;
+                    for (i, value) in values.iter().take(D).enumerate() {
+                        if let Some(value) = value {
+                            for &node in nodes {
+                                velocity_dofs[node * D + i] = Some(*value);
                             }
                         }
                     }
@@ -1347,6 +1495,8 @@ impl<const D: usize> Problem<D> {
                 })
                 .unwrap_or(0)
         };
+        let mut explicit_gravity = SVector::<f64, D>::zeros();
+        let mut explicit_forces: Vec<(usize, SVector<f64, D>)> = Vec::new();
         for spec in &scene.loads {
             let kind = *spec.kind.get_ref();
             let curve = curve_of(&spec.curve)?;
@@ -1384,6 +1534,36 @@ impl<const D: usize> Problem<D> {
                         LoadKind::Manufactured => "manufactured",
                     };
                     return Err(refuse(key, name));
+                }
+            }
+            if explicit {
+                if let Some(c) = &spec.curve {
+                    return Err(src.at(
+                        c,
+                        "load curves follow the implicit solver's load factor; the explicit solver's loads are constant in time",
+                    ));
+                }
+                match kind {
+                    LoadKind::Manufactured => {
+                        return Err(src.at(
+                            &spec.kind,
+                            "a manufactured load balances a quasi-static solution; the explicit solver does not take it",
+                        ));
+                    }
+                    LoadKind::Gravity => {
+                        if let Some(b) = &spec.body {
+                            return Err(src.at(
+                                b,
+                                "the explicit solver's gravity acts on every body: leave out `body`",
+                            ));
+                        }
+                        let Some(a) = &spec.acceleration else {
+                            return Err(src.at(&spec.kind, "a gravity load needs `acceleration`"));
+                        };
+                        explicit_gravity += point::<D>(a, "`acceleration`", src)?;
+                        continue;
+                    }
+                    LoadKind::Point | LoadKind::Traction => {}
                 }
             }
             let mut forces: Vec<SVector<f64, D>> = Vec::new();
@@ -1529,6 +1709,17 @@ impl<const D: usize> Problem<D> {
             if forces.is_empty() {
                 continue;
             }
+            if explicit {
+                // Point loads and tractions: constant forces on their points.
+                explicit_forces.extend(
+                    forces
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, f)| **f != SVector::<f64, D>::zeros())
+                        .map(|(p, f)| (p, *f)),
+                );
+                continue;
+            }
             if curve == 0 {
                 if kind == LoadKind::Point {
                     point_forces.extend(
@@ -1607,7 +1798,7 @@ impl<const D: usize> Problem<D> {
                 }
                 iterative.rel_tolerance = t;
             }
-            match s.linear {
+            match *s.linear.get_ref() {
                 LinearKind::Direct => mpm_solver::LinearChoice::Direct,
                 LinearKind::Iterative => mpm_solver::LinearChoice::Iterative(iterative),
                 LinearKind::Auto => mpm_solver::LinearChoice::Auto {
@@ -1617,7 +1808,7 @@ impl<const D: usize> Problem<D> {
             }
         };
         if let Some(t) = &s.linear_tolerance
-            && s.linear == LinearKind::Direct
+            && *s.linear.get_ref() == LinearKind::Direct
         {
             return Err(src.at(
                 t,
@@ -1625,7 +1816,7 @@ impl<const D: usize> Problem<D> {
             ));
         }
         if let Some(m) = &s.max_direct_dofs
-            && s.linear != LinearKind::Auto
+            && *s.linear.get_ref() != LinearKind::Auto
         {
             return Err(src.at(
                 m,
@@ -1636,6 +1827,20 @@ impl<const D: usize> Problem<D> {
         // Outputs.
         let o = &scene.output;
         let every = check.at_least(&o.every, 1, "output `every`")?;
+        if explicit {
+            if SolverSpec::given(&o.every) {
+                return Err(src.at(
+                    &o.every,
+                    "output `every` counts the implicit solver's load steps; an explicit run writes every [solver] `output_interval` of simulated time",
+                ));
+            }
+            if let Some(r) = o.reactions.first() {
+                return Err(src.at(
+                    &r.name,
+                    "reaction outputs are the implicit solver's nodal reactions; the explicit solver does not compute them",
+                ));
+            }
+        }
         let safe = |name: &Spanned<String>| -> Result<String, CasesError> {
             let v = name.get_ref();
             if v.is_empty()
@@ -1680,6 +1885,34 @@ impl<const D: usize> Problem<D> {
             return Err(src.error(None, "output `png` draws 2D scenes only"));
         }
         let fields = o.fields.clone().unwrap_or_else(|| Field::ALL.to_vec());
+        let explicit = explicit_keys.map(|k| {
+            // One call per component and value (each call sorts the list).
+            let mut groups: BTreeMap<(usize, u64), Vec<usize>> = BTreeMap::new();
+            for (dof, v) in velocity_dofs.iter().enumerate() {
+                if let Some(v) = v {
+                    groups
+                        .entry((dof % D, v.to_bits()))
+                        .or_default()
+                        .push(dof / D);
+                }
+            }
+            let mut fixities = mpm_solver::VelocityFixities::new();
+            for ((component, bits), nodes) in groups {
+                fixities.prescribe(nodes, component, f64::from_bits(bits));
+            }
+            ExplicitSetup {
+                end_time: k.end_time,
+                output_interval: k.output_interval,
+                time_step: k.time_step,
+                transfer: k.transfer,
+                alpha: k.alpha,
+                locking: k.locking,
+                gravity: explicit_gravity,
+                fixities,
+                velocity: initial_velocity,
+                point_forces: explicit_forces,
+            }
+        });
 
         Ok(Self {
             mesh,
@@ -1701,8 +1934,8 @@ impl<const D: usize> Problem<D> {
             newton: NewtonOptions {
                 tolerance,
                 max_iterations,
-                predictor: s.predictor,
-                first_tangent: s.first_tangent.into(),
+                predictor: *s.predictor.get_ref(),
+                first_tangent: (*s.first_tangent.get_ref()).into(),
                 linear,
                 ..NewtonOptions::default()
             },
@@ -1713,6 +1946,7 @@ impl<const D: usize> Problem<D> {
             every,
             fields,
             png: o.png,
+            explicit,
         })
     }
 
@@ -2013,17 +2247,37 @@ fn displacement_of<const D: usize>(
     d: &Spanned<super::format::Axes>,
     src: &SceneSource,
 ) -> Result<[Option<f64>; 3], CasesError> {
+    axes_of::<D>(d, "displacement", src)
+}
+
+/// The components of a per-axis table named `key`, checked against the
+/// dimension (at least one given, all finite).
+fn axes_of<const D: usize>(
+    d: &Spanned<super::format::Axes>,
+    key: &str,
+    src: &SceneSource,
+) -> Result<[Option<f64>; 3], CasesError> {
     let values = d.get_ref().get();
     if let Some(axis) = (D..3).find(|&i| values[i].is_some()) {
         return Err(src.at(d, format!("a {D}D scene has no {} component", AXES[axis])));
     }
     if values.iter().all(Option::is_none) {
-        return Err(src.at(d, "`displacement` needs at least one of x, y, z"));
+        return Err(src.at(d, format!("`{key}` needs at least one of x, y, z")));
     }
     if let Some(v) = values.iter().flatten().find(|v| !v.is_finite()) {
-        return Err(src.at(d, format!("`displacement` must be finite, got {v}")));
+        return Err(src.at(d, format!("`{key}` must be finite, got {v}")));
     }
     Ok(values)
+}
+
+/// The name of a boundary kind in scene files.
+fn boundary_kind_name(kind: BoundaryKind) -> &'static str {
+    match kind {
+        BoundaryKind::Fixed => "fixed",
+        BoundaryKind::Roller => "roller",
+        BoundaryKind::Displacement => "displacement",
+        BoundaryKind::Velocity => "velocity",
+    }
 }
 
 /// A `gradient`: `D` rows of `D` finite numbers.
@@ -2325,6 +2579,237 @@ impl<const D: usize> Points<D> {
         Ok(step)
     }
 }
+
+/// The `[solver]` keys of an explicit run, checked.
+#[derive(Debug, Clone, Copy)]
+struct ExplicitKeys {
+    end_time: f64,
+    output_interval: f64,
+    time_step: mpm_solver::TimeStep,
+    transfer: TransferKind,
+    alpha: f64,
+    locking: LockingKind,
+}
+
+/// Checks the `[solver]` keys against the solver kind: the keys of the
+/// other kind are refused where they are, and the explicit keys are
+/// checked and completed with their defaults (`None` for the implicit
+/// solver).
+fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>, CasesError> {
+    let span = |v: &Option<Spanned<f64>>| v.as_ref().map(Spanned::span);
+    let explicit_keys = [
+        ("end_time", span(&s.end_time)),
+        ("cfl", span(&s.cfl)),
+        ("time_step", span(&s.time_step)),
+        ("transfer", s.transfer.as_ref().map(Spanned::span)),
+        ("alpha", span(&s.alpha)),
+        ("output_interval", span(&s.output_interval)),
+    ];
+    if s.kind() == SolverKind::Implicit {
+        if let Some((key, Some(at))) = explicit_keys.into_iter().find(|(_, at)| at.is_some()) {
+            return Err(src.error(
+                Some(at),
+                &format!(
+                    "solver `{key}` applies to kind = \"explicit\" (the implicit solver steps the load factor: `steps`, `max_increment`, `min_increment`)"
+                ),
+            ));
+        }
+        if *s.locking.get_ref() == LockingKind::CellAveraged {
+            return Err(src.at(&s.locking, crate::variant::CELL_AVERAGED_IMPLICIT));
+        }
+        return Ok(None);
+    }
+    let given = |present: bool, at: std::ops::Range<usize>| present.then_some(at);
+    let implicit_keys = [
+        (
+            "formulation",
+            given(SolverSpec::given(&s.formulation), s.formulation.span()),
+        ),
+        (
+            "domain_update",
+            given(SolverSpec::given(&s.domain_update), s.domain_update.span()),
+        ),
+        (
+            "gimp_volume",
+            given(SolverSpec::given(&s.gimp_volume), s.gimp_volume.span()),
+        ),
+        ("steps", given(SolverSpec::given(&s.steps), s.steps.span())),
+        ("max_increment", span(&s.max_increment)),
+        ("min_increment", span(&s.min_increment)),
+        (
+            "tolerance",
+            given(SolverSpec::given(&s.tolerance), s.tolerance.span()),
+        ),
+        (
+            "max_iterations",
+            given(
+                SolverSpec::given(&s.max_iterations),
+                s.max_iterations.span(),
+            ),
+        ),
+        (
+            "predictor",
+            given(SolverSpec::given(&s.predictor), s.predictor.span()),
+        ),
+        (
+            "first_tangent",
+            given(SolverSpec::given(&s.first_tangent), s.first_tangent.span()),
+        ),
+        (
+            "linear",
+            given(SolverSpec::given(&s.linear), s.linear.span()),
+        ),
+        ("linear_tolerance", span(&s.linear_tolerance)),
+        (
+            "max_direct_dofs",
+            s.max_direct_dofs.as_ref().map(Spanned::span),
+        ),
+    ];
+    if let Some((key, Some(at))) = implicit_keys.into_iter().find(|(_, at)| at.is_some()) {
+        return Err(src.error(
+            Some(at),
+            &format!(
+                "solver `{key}` applies to the implicit solver; kind = \"explicit\" steps in time (`end_time`, `cfl` or `time_step`)"
+            ),
+        ));
+    }
+    if let Some(b) = &s.basis
+        && matches!(b.get_ref(), BasisKind::Gimp | BasisKind::Cpdi2)
+    {
+        return Err(src.at(
+            b,
+            format!(
+                "basis = {} needs a domain per point and a rule that updates it in time, which the explicit solver does not have yet; use basis = \"bspline2\" (the default) or \"linear\"",
+                b.get_ref()
+            ),
+        ));
+    }
+    let locking = *s.locking.get_ref();
+    if matches!(locking, LockingKind::FBar | LockingKind::FPatch) {
+        return Err(src.at(
+            &s.locking,
+            format!(
+                "locking = {locking} is an implicit treatment; the explicit solver takes locking = \"none\" or \"cell_averaged\""
+            ),
+        ));
+    }
+    let Some(end) = &s.end_time else {
+        return Err(src.at(
+            &s.kind,
+            "kind = \"explicit\" needs `end_time`, the simulated time to reach (s)",
+        ));
+    };
+    let end_time = *end.get_ref();
+    if end_time <= 0.0 {
+        return Err(src.at(
+            end,
+            format!("solver `end_time` must be positive, got {end_time}"),
+        ));
+    }
+    let time_step = match (&s.cfl, &s.time_step) {
+        (Some(_), Some(dt)) => {
+            return Err(src.at(
+                dt,
+                "give solver `cfl` or `time_step`, not both (a fixed step ignores the CFL condition)",
+            ));
+        }
+        (Some(c), None) => {
+            let factor = *c.get_ref();
+            if !(factor > 0.0 && factor <= 1.0) {
+                return Err(src.at(c, format!("solver `cfl` must lie in (0, 1], got {factor}")));
+            }
+            mpm_solver::TimeStep::Cfl { factor }
+        }
+        (None, Some(dt)) => {
+            let value = *dt.get_ref();
+            if value <= 0.0 {
+                return Err(src.at(
+                    dt,
+                    format!("solver `time_step` must be positive, got {value}"),
+                ));
+            }
+            if end_time / value > 1e9 {
+                return Err(src.at(
+                    dt,
+                    format!("solver `time_step` {value:e} would take more than 1e9 steps to reach end_time {end_time}"),
+                ));
+            }
+            mpm_solver::TimeStep::Fixed(value)
+        }
+        (None, None) => mpm_solver::TimeStep::Cfl {
+            factor: DEFAULT_CFL,
+        },
+    };
+    let transfer = s
+        .transfer
+        .as_ref()
+        .map_or(TransferKind::default(), |t| *t.get_ref());
+    let alpha =
+        match (transfer, &s.alpha) {
+            (TransferKind::Blend, Some(a)) => {
+                let alpha = *a.get_ref();
+                if !(0.0..=1.0).contains(&alpha) {
+                    return Err(
+                        src.at(a, format!("solver `alpha` must lie in [0, 1], got {alpha}"))
+                    );
+                }
+                alpha
+            }
+            (TransferKind::Blend, None) => {
+                let at = s.transfer.as_ref().map_or(s.kind.span(), Spanned::span);
+                return Err(src.error(
+                    Some(at),
+                    "transfer = \"blend\" needs `alpha`, its FLIP fraction in [0, 1]",
+                ));
+            }
+            (other, Some(a)) => {
+                return Err(src.at(
+                a,
+                format!(
+                    "solver `alpha` applies to transfer = \"blend\" (transfer = \"{}\" has α = {})",
+                    other.name(),
+                    if matches!(other, TransferKind::Pic | TransferKind::Tpic) { 0 } else { 1 }
+                ),
+            ));
+            }
+            (TransferKind::Pic | TransferKind::Tpic, None) => 0.0,
+            (TransferKind::Flip | TransferKind::Tflip, None) => 1.0,
+        };
+    let output_interval = match &s.output_interval {
+        Some(o) => {
+            let value = *o.get_ref();
+            if value <= 0.0 {
+                return Err(src.at(
+                    o,
+                    format!("solver `output_interval` must be positive, got {value}"),
+                ));
+            }
+            if end_time / value > 1e6 {
+                return Err(src.at(
+                    o,
+                    format!("solver `output_interval` {value:e} would write more than 1e6 outputs before end_time {end_time}"),
+                ));
+            }
+            value
+        }
+        None => end_time / DEFAULT_OUTPUTS as f64,
+    };
+    Ok(Some(ExplicitKeys {
+        end_time,
+        output_interval,
+        time_step,
+        transfer,
+        alpha,
+        locking,
+    }))
+}
+
+/// The CFL factor of an explicit scene without `cfl` or `time_step`.
+pub const DEFAULT_CFL: f64 = 0.5;
+
+/// Outputs of an explicit scene without `output_interval` (besides the
+/// initial state): `end_time / 20` apart.
+pub const DEFAULT_OUTPUTS: usize = 20;
 
 #[cfg(test)]
 mod tests {

@@ -280,6 +280,10 @@ pub struct BodySpec {
     /// that is not aligned with the grid.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lattice_origin: Option<Spanned<Vec<f64>>>,
+    /// Explicit solver: the initial velocity of the body's points (m/s;
+    /// default at rest).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<Spanned<Vec<f64>>>,
 }
 
 /// Placement of a body's points.
@@ -327,7 +331,8 @@ pub enum BoundaryKind {
     Roller,
     /// Components given in `displacement` prescribed, following `curve`.
     Displacement,
-    /// Prescribed velocity (explicit solver; refused by the implicit one).
+    /// The components given in `velocity` prescribed at a constant nodal
+    /// velocity (explicit solver; refused by the implicit one).
     Velocity,
 }
 
@@ -376,6 +381,10 @@ pub struct BoundarySpec {
     /// factor).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curve: Option<Spanned<String>>,
+    /// For `velocity` (explicit solver): the constant nodal velocity of the
+    /// given components (m/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<Spanned<Axes>>,
 }
 
 /// Kinds of load.
@@ -452,24 +461,65 @@ pub enum SolverKind {
     /// Quasi-static implicit Newton–Raphson.
     #[default]
     Implicit,
+    /// Explicit dynamics (`mpm_solver::ExplicitSolver`): update-stress-last
+    /// with a lumped mass matrix, in time up to `end_time`.
+    Explicit,
 }
 
-/// `[solver]`.
+/// `solver.transfer`: how the explicit solver carries velocities between
+/// points and grid (`mpm_solver::explicit::Transfer`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TransferKind {
+    /// Particle-in-cell (α = 0): dissipative.
+    Pic,
+    /// Fluid-implicit-particle (α = 1), the default.
+    #[default]
+    Flip,
+    /// The PIC/FLIP blend with FLIP fraction `alpha`.
+    Blend,
+    /// Taylor-PIC: PIC with the points' velocity gradients in the momentum
+    /// projection.
+    Tpic,
+    /// Taylor-FLIP.
+    Tflip,
+}
+
+impl TransferKind {
+    /// The name in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            TransferKind::Pic => "pic",
+            TransferKind::Flip => "flip",
+            TransferKind::Blend => "blend",
+            TransferKind::Tpic => "tpic",
+            TransferKind::Tflip => "tflip",
+        }
+    }
+}
+
+/// `[solver]`. The keys of one solver kind are refused with the other
+/// ([`super::build`]): Newton and load-stepping keys with `kind =
+/// "explicit"`, time-stepping keys with `kind = "implicit"`. Values whose
+/// presence matters keep their place (`Spanned`; a default has the empty
+/// span `0..0`).
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSpec {
     /// The solver.
-    pub kind: SolverKind,
-    /// Basis functions.
-    pub basis: BasisKind,
-    /// Statement of equilibrium.
-    pub formulation: FormulationKind,
+    pub kind: Spanned<SolverKind>,
+    /// Basis functions (default: `linear` for the implicit solver,
+    /// `bspline2` for the explicit one; [`SolverSpec::basis`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub basis: Option<Spanned<BasisKind>>,
+    /// Statement of equilibrium (implicit).
+    pub formulation: Spanned<FormulationKind>,
     /// Locking treatment.
-    pub locking: LockingKind,
-    /// GIMP domain update.
-    pub domain_update: DomainUpdateKind,
-    /// Integration volume of GIMP points.
-    pub gimp_volume: GimpVolumeKind,
+    pub locking: Spanned<LockingKind>,
+    /// GIMP domain update (implicit).
+    pub domain_update: Spanned<DomainUpdateKind>,
+    /// Integration volume of GIMP points (implicit).
+    pub gimp_volume: Spanned<GimpVolumeKind>,
     /// Number of equal load steps (the first increment is 1/steps).
     pub steps: Spanned<usize>,
     /// Largest load increment with automatic stepping (default 1/steps:
@@ -487,12 +537,12 @@ pub struct SolverSpec {
     /// Start each step from the previous step's increment (a secant
     /// predictor; keeps Newton on the branch of the previous step where
     /// perfectly plastic equilibrium paths bifurcate).
-    pub predictor: bool,
+    pub predictor: Spanned<bool>,
     /// The tangent of a step's first solve when it starts from prescribed
     /// increments alone ([`mpm_solver::FirstTangent`]).
-    pub first_tangent: FirstTangentSpec,
+    pub first_tangent: Spanned<FirstTangentSpec>,
     /// The linear solver of each Newton iteration.
-    pub linear: LinearKind,
+    pub linear: Spanned<LinearKind>,
     /// Relative tolerance of the iterative linear solver (default 1e-12).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub linear_tolerance: Option<Spanned<f64>>,
@@ -501,6 +551,53 @@ pub struct SolverSpec {
     /// [`mpm_solver::DEFAULT_MAX_DIRECT_DOFS_2D`] in 2D).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_direct_dofs: Option<Spanned<usize>>,
+    /// Explicit: the simulated time the run ends at (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end_time: Option<Spanned<f64>>,
+    /// Explicit: the CFL safety factor in (0, 1] (default 0.5).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cfl: Option<Spanned<f64>>,
+    /// Explicit: a fixed time step (s) instead of the CFL condition.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_step: Option<Spanned<f64>>,
+    /// Explicit: the velocity transfer (default `flip`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub transfer: Option<Spanned<TransferKind>>,
+    /// Explicit, `transfer = "blend"`: the FLIP fraction in [0, 1].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alpha: Option<Spanned<f64>>,
+    /// Explicit: simulated time between outputs (default `end_time`/20).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub output_interval: Option<Spanned<f64>>,
+}
+
+impl SolverSpec {
+    /// Whether `value` was given in the scene or an override (a default
+    /// has the empty span `0..0`).
+    pub fn given<T>(value: &Spanned<T>) -> bool {
+        value.span() != (0..0)
+    }
+
+    /// The solver kind.
+    pub fn kind(&self) -> SolverKind {
+        *self.kind.get_ref()
+    }
+
+    /// The basis: the one given, or the default of the solver kind
+    /// (`linear` implicit, `bspline2` explicit: the MPoint notes' default,
+    /// free of the cell-crossing noise of linear MPM in dynamics).
+    pub fn basis(&self) -> BasisKind {
+        match (&self.basis, self.kind()) {
+            (Some(b), _) => *b.get_ref(),
+            (None, SolverKind::Implicit) => crate::variant::Variant::default().basis,
+            (None, SolverKind::Explicit) => BasisKind::BSpline2,
+        }
+    }
+
+    /// Padding cells the scene's basis needs ([`BasisKind::padding`]).
+    pub fn padding(&self) -> usize {
+        self.basis().padding()
+    }
 }
 
 /// `solver.linear`.
@@ -540,23 +637,32 @@ impl Default for SolverSpec {
     fn default() -> Self {
         let v = crate::variant::Variant::default();
         let newton = mpm_solver::NewtonOptions::default();
+        fn at<T>(x: T) -> Spanned<T> {
+            Spanned::new(0..0, x)
+        }
         Self {
-            kind: SolverKind::Implicit,
-            basis: v.basis,
-            formulation: v.formulation,
-            locking: v.locking,
-            domain_update: v.domain_update,
-            gimp_volume: v.gimp_volume,
+            kind: at(SolverKind::Implicit),
+            basis: None,
+            formulation: at(v.formulation),
+            locking: at(v.locking),
+            domain_update: at(v.domain_update),
+            gimp_volume: at(v.gimp_volume),
             steps: Spanned::new(0..0, 10),
             max_increment: None,
             min_increment: None,
             tolerance: Spanned::new(0..0, 1e-9),
             max_iterations: Spanned::new(0..0, newton.max_iterations),
-            predictor: newton.predictor,
-            first_tangent: FirstTangentSpec::default(),
-            linear: LinearKind::default(),
+            predictor: at(newton.predictor),
+            first_tangent: at(FirstTangentSpec::default()),
+            linear: at(LinearKind::default()),
             linear_tolerance: None,
             max_direct_dofs: None,
+            end_time: None,
+            cfl: None,
+            time_step: None,
+            transfer: None,
+            alpha: None,
+            output_interval: None,
         }
     }
 }

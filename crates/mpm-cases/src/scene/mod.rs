@@ -48,7 +48,7 @@
 //! acceleration = [0.0, -10.0]
 //! "#;
 //! let (scene, source) = scene::parse(text, "column.toml", &[])?;
-//! let problem = Problem::<2>::build(&scene, &source, scene.solver.basis.padding())?;
+//! let problem = Problem::<2>::build(&scene, &source, scene.solver.padding())?;
 //! let out = scene::run(&problem, &RunControl::default(), |_, _, _| Ok(()))?;
 //! // The base carries the weight: 80 kg/m³ × 10 m/s² × 10 m².
 //! let reaction = out.reports.last().unwrap().reaction;
@@ -57,13 +57,17 @@
 //! ```
 
 pub mod build;
+pub mod explicit;
 pub mod format;
 pub mod png;
 mod program;
 pub mod region;
 mod runner;
 
-pub use build::{Problem, ReactionOutput, SceneConstraints, SceneMotion};
+pub use build::{ExplicitSetup, Problem, ReactionOutput, SceneConstraints, SceneMotion};
+pub use explicit::{
+    ExplicitEvent, ExplicitFrame, ExplicitObserver, ExplicitOutput, RunExplicit, run_explicit,
+};
 pub use format::Scene;
 pub use program::run_file;
 pub use runner::{RunScene, run};

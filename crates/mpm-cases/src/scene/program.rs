@@ -33,16 +33,28 @@ fn scene_run_in<const D: usize>(
     session: &Session,
 ) -> Result<(), CasesError>
 where
-    crate::scene::Problem<D>: crate::scene::RunScene<D>,
+    crate::scene::Problem<D>: crate::scene::RunScene<D> + crate::scene::RunExplicit<D>,
 {
     use crate::scene::Problem;
 
-    let problem = Problem::<D>::build_in(
-        scene,
-        source,
-        scene.solver.basis.padding(),
-        &session.scene_dir,
-    )?;
+    let problem =
+        Problem::<D>::build_in(scene, source, scene.solver.padding(), &session.scene_dir)?;
+    if problem.explicit.is_some() {
+        if session.export_tangent {
+            return Err(source.error(
+                None,
+                "--export-tangent writes the implicit solver's stiffness; an explicit run assembles none",
+            ));
+        }
+        return match &problem.mesh {
+            crate::scene::build::SceneMesh::Grid(g) => {
+                explicit_run_on(scene, &problem, session, g.clone())
+            }
+            crate::scene::build::SceneMesh::Simplex(_) => {
+                Err(source.error(None, "the explicit solver runs on regular grids"))
+            }
+        };
+    }
     match &problem.mesh {
         crate::scene::build::SceneMesh::Grid(g) => {
             scene_run_on(scene, &problem, session, g.clone())
@@ -70,24 +82,7 @@ where
     obs.writer.set_vtu_options(VtuOptions {
         every: problem.every,
         fields: problem.fields.clone(),
-        constants: vec![
-            (
-                "body".into(),
-                problem
-                    .body_of_point
-                    .iter()
-                    .map(|&b| f64::from(b))
-                    .collect(),
-            ),
-            (
-                "material".into(),
-                problem
-                    .material_of_point
-                    .iter()
-                    .map(|&m| f64::from(m))
-                    .collect(),
-            ),
-        ],
+        constants: point_constants(problem),
     });
     let axes = ["x", "y", "z"];
     let reaction_header: Vec<String> = std::iter::once("load_factor".to_owned())
@@ -150,32 +145,8 @@ where
         ),
     );
     if problem.png {
-        let last = &r.last;
-        let plastic = last.plastic_strain.iter().any(|&e| e > 0.0);
-        let (name, value): (&str, Vec<f64>) = if plastic {
-            ("equivalent_plastic_strain", last.plastic_strain.clone())
-        } else {
-            (
-                "displacement_magnitude",
-                last.displacement
-                    .iter()
-                    .map(|u| (u[0] * u[0] + u[1] * u[1]).sqrt())
-                    .collect(),
-            )
-        };
-        let half: Vec<f64> = problem
-            .half_lengths
-            .iter()
-            .zip(&last.volume)
-            .zip(&problem.volume)
-            .map(|((l, v), v0)| l[0] * (v / v0).sqrt())
-            .collect();
-        let path = obs.writer.dir().join("final.png");
-        let (lo, hi) = crate::scene::png::write_points_png(&path, &last.position, &half, &value)?;
-        results.insert(
-            "png".into(),
-            json!({"file": "final.png", "colour": name, "blue": lo, "red": hi}),
-        );
+        let png = write_png(problem, &r.last, obs.writer.dir())?;
+        results.insert("png".into(), png);
     }
     let s = summary(
         "scene",
@@ -187,4 +158,201 @@ where
         scene,
     );
     obs.finish(s)
+}
+
+/// `final.png` of the final state `last` in `dir`: the points coloured by
+/// the equivalent plastic strain if any point yielded, else by the
+/// displacement magnitude; returns its `summary.json` entry.
+fn write_png<const D: usize>(
+    problem: &crate::scene::Problem<D>,
+    last: &crate::run::Snapshot,
+    dir: &std::path::Path,
+) -> Result<Value, CasesError> {
+    let plastic = last.plastic_strain.iter().any(|&e| e > 0.0);
+    let (name, value): (&str, Vec<f64>) = if plastic {
+        ("equivalent_plastic_strain", last.plastic_strain.clone())
+    } else {
+        (
+            "displacement_magnitude",
+            last.displacement
+                .iter()
+                .map(|u| (u[0] * u[0] + u[1] * u[1]).sqrt())
+                .collect(),
+        )
+    };
+    let half: Vec<f64> = problem
+        .half_lengths
+        .iter()
+        .zip(&last.volume)
+        .zip(&problem.volume)
+        .map(|((l, v), v0)| l[0] * (v / v0).sqrt())
+        .collect();
+    let path = dir.join("final.png");
+    let (lo, hi) = crate::scene::png::write_points_png(&path, &last.position, &half, &value)?;
+    Ok(json!({"file": "final.png", "colour": name, "blue": lo, "red": hi}))
+}
+
+/// The per-point constants of the VTU files: body and material indices.
+fn point_constants<const D: usize>(problem: &crate::scene::Problem<D>) -> Vec<(String, Vec<f64>)> {
+    vec![
+        (
+            "body".into(),
+            problem
+                .body_of_point
+                .iter()
+                .map(|&b| f64::from(b))
+                .collect(),
+        ),
+        (
+            "material".into(),
+            problem
+                .material_of_point
+                .iter()
+                .map(|&m| f64::from(m))
+                .collect(),
+        ),
+    ]
+}
+
+/// The energies as `summary.json` writes them.
+fn energies_json(e: &mpm_solver::explicit::Energies) -> Value {
+    json!({
+        "kinetic": e.kinetic,
+        "strain": e.strain,
+        "gravitational": e.gravitational,
+        "external_work": e.external_work,
+        "total": e.total(),
+    })
+}
+
+/// Runs a built explicit scene on its grid: the VTU series and a row of
+/// `energy.csv` (and of every probe's history) at every output time, a
+/// checkpoint with each output, `summary.json` at the end.
+fn explicit_run_on<const D: usize>(
+    scene: &crate::scene::Scene,
+    problem: &crate::scene::Problem<D>,
+    session: &Session,
+    grid: mpm_mesh::RegularGrid<D>,
+) -> Result<(), CasesError>
+where
+    crate::scene::Problem<D>: crate::scene::RunExplicit<D>,
+{
+    use crate::output::CsvValue;
+    use crate::scene::ExplicitEvent;
+    use crate::writer::{ExplicitSummary, VtuOptions};
+
+    let Some(setup) = problem.explicit.as_ref() else {
+        return Err(CasesError::Solver(mpm_solver::SolverError::InvalidInput(
+            "the scene's solver is implicit".into(),
+        )));
+    };
+    let end_time = setup.end_time;
+    let (mut obs, control) = session.start(scene, grid)?;
+    obs.show_time();
+    obs.writer.set_vtu_options(VtuOptions {
+        every: 1,
+        fields: problem.fields.clone(),
+        constants: point_constants(problem),
+    });
+    const ENERGY_HEADER: [&str; 6] = [
+        "time",
+        "kinetic",
+        "strain",
+        "gravitational",
+        "external_work",
+        "total",
+    ];
+    let axes = ["x", "y", "z"];
+    let probe_header: Vec<String> = std::iter::once("time".to_owned())
+        .chain(axes.iter().take(D).map(|a| format!("u{a}")))
+        .collect();
+    let probe_header: Vec<&str> = probe_header.iter().map(String::as_str).collect();
+    let mut last_probes = Map::new();
+    let run = crate::scene::run_explicit(problem, &control, |event| match event {
+        ExplicitEvent::Step(info) => {
+            obs.explicit_step(info.time, end_time, info.step, info.dt);
+            Ok(())
+        }
+        ExplicitEvent::Output(frame) => {
+            let e = &frame.energies;
+            let row = [
+                frame.time,
+                e.kinetic,
+                e.strain,
+                e.gravitational,
+                e.external_work,
+                e.total(),
+            ]
+            .map(CsvValue::from);
+            obs.writer
+                .case_row("energy.csv", &ENERGY_HEADER, &row)
+                .map_err(observer_error)?;
+            for (name, p) in &problem.probes {
+                let u = &frame.snapshot.displacement[*p][..D];
+                let mut row = vec![CsvValue::from(frame.time)];
+                row.extend(u.iter().map(|x| CsvValue::from(*x)));
+                obs.writer
+                    .case_row(&format!("probe_{name}.csv"), &probe_header, &row)
+                    .map_err(observer_error)?;
+                last_probes.insert(name.clone(), json!(u));
+            }
+            obs.explicit_output(
+                frame.index,
+                frame.time,
+                end_time,
+                frame.steps,
+                frame.snapshot,
+            )
+        }
+    });
+    let r = match run {
+        Err(mpm_solver::SolverError::Stopped { step, load_factor }) => {
+            println!(
+                "stopped after output {step} at t = {} s; continue with --resume",
+                crate::session::shown(load_factor)
+            );
+            return Ok(());
+        }
+        other => other?,
+    };
+    let mut results = Map::new();
+    results.insert("probes".into(), Value::Object(last_probes));
+    results.insert(
+        "bodies".into(),
+        json!(
+            problem
+                .bodies
+                .iter()
+                .map(|b| json!({"name": b.name, "material_points": b.points.len()}))
+                .collect::<Vec<_>>()
+        ),
+    );
+    if problem.png {
+        let png = write_png(problem, &r.last, obs.writer.dir())?;
+        results.insert("png".into(), png);
+    }
+    let summary = ExplicitSummary {
+        case: "scene".into(),
+        solver: "explicit".into(),
+        basis: problem.variant.basis,
+        transfer: setup.transfer,
+        alpha: setup.alpha,
+        locking: setup.locking,
+        material_points: problem.len(),
+        time_steps: r.steps,
+        end_time: r.time,
+        outputs: r.outputs,
+        wall_time_s: r.wall_time_s,
+        stage_times_s: json!({
+            "p2g": r.stage_times.p2g,
+            "grid": r.stage_times.grid,
+            "g2p": r.stage_times.g2p,
+        }),
+        initial_energies: energies_json(&r.initial),
+        final_energies: energies_json(&r.last_energies),
+        energy_drift: r.energy_drift,
+        results,
+        parameters: scene,
+    };
+    obs.finish_explicit(summary)
 }

@@ -88,6 +88,11 @@ fn run_in<const D: usize>(
     control: &RunControl,
     observer: &mut StepObserver<'_, D>,
 ) -> Result<RunOutput<D>, SolverError> {
+    if problem.explicit.is_some() {
+        return Err(SolverError::InvalidInput(
+            "the scene's solver is explicit: run it with scene::run_explicit".into(),
+        ));
+    }
     match &problem.mesh {
         SceneMesh::Grid(grid) => dispatch(
             &problem.variant,

@@ -1,0 +1,777 @@
+//! Runs a scene with `[solver] kind = "explicit"`: the basis, the law, the
+//! velocity transfer and the dilatation treatment it names are dispatched
+//! to a fully monomorphised [`ExplicitSolver`], which steps the points to
+//! `end_time`; at every output time (`output_interval` apart, and at the
+//! end) the caller's observer sees the energies and a [`Snapshot`] of the
+//! points, with a [`Checkpoint`] to resume from when asked for.
+//!
+//! The solvers are compiled once per dimension, here ([`RunExplicit`]):
+//! basis (`linear`, `bspline2`) × law (closed-form `NeoHookean`,
+//! `Spectral<HenckyElastic>`, `Spectral<VonMises>`) × transfer
+//! (`FlipPic`, which covers PIC, FLIP and their blend; `Taylor`) ×
+//! dilatation (`NoLocking`, `CellAveraged`): 24 solvers per dimension.
+//!
+//! ```
+//! use mpm_cases::run::RunControl;
+//! use mpm_cases::scene::{self, ExplicitEvent, Problem};
+//!
+//! // A free block moving at 1 m/s for 0.1 s: it translates rigidly.
+//! let text = r#"
+//! [mesh]
+//! origin = [0.0, 0.0]
+//! size = [2.0, 1.0]
+//! cells = [8, 4]
+//!
+//! [[material]]
+//! name = "rubber"
+//! model = "neo_hookean"
+//! youngs_modulus = 1e4
+//! poisson_ratio = 0.3
+//! density = 1000.0
+//!
+//! [[body]]
+//! name = "block"
+//! material = "rubber"
+//! region = { box = { lower = [0.5, 0.25], upper = [1.0, 0.75] } }
+//! velocity = [1.0, 0.0]
+//!
+//! [solver]
+//! kind = "explicit"
+//! end_time = 0.1
+//! "#;
+//! let (scene, source) = scene::parse(text, "block.toml", &[])?;
+//! let problem = Problem::<2>::build(&scene, &source, scene.solver.padding())?;
+//! let mut outputs = 0;
+//! let out = scene::run_explicit(&problem, &RunControl::default(), |event| {
+//!     if let ExplicitEvent::Output(_) = event {
+//!         outputs += 1;
+//!     }
+//!     Ok(())
+//! })?;
+//! assert_eq!(outputs, 21); // t = 0 and every end_time/20
+//! assert!((out.last.displacement[0][0] - 0.1).abs() < 1e-9);
+//! assert!(out.energy_drift.abs() < 1e-9);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::time::Instant;
+
+use mpm_basis::{BasisFunction, LinearMpm, QuadraticBSpline};
+use mpm_constitutive::{
+    HenckyElastic, IncrementalLaw, MaterialState, NeoHookean, Spectral, VonMises,
+};
+use mpm_mesh::RegularGrid;
+use mpm_solver::explicit::{
+    DilatationTreatment, Energies, ExplicitStageTimes, PointsFor, StepInfo, VelocityGradient,
+};
+use mpm_solver::{
+    CellAveraged, ExplicitOptions, ExplicitPoints, ExplicitSolver, Flat, FlipPic, NoLocking,
+    RunState, RunSummary, SolverError, Taylor, Transfer,
+};
+use nalgebra::{Matrix3, SVector};
+
+use crate::material::MaterialModel;
+use crate::run::{Checkpoint, HistoryOutput, RunControl, Snapshot};
+use crate::variant::{BasisKind, LockingKind};
+
+use super::build::{ExplicitSetup, Problem, SceneMesh};
+use super::format::TransferKind;
+
+/// What an explicit run reports to its observer.
+#[derive(Debug)]
+pub enum ExplicitEvent<'a> {
+    /// A time step was taken.
+    Step(StepInfo),
+    /// An output time was reached (or the initial state, output 0).
+    Output(ExplicitFrame<'a>),
+}
+
+/// The state of an explicit run at an output time.
+#[derive(Debug)]
+pub struct ExplicitFrame<'a> {
+    /// Output number: 0 for the initial state, then 1, 2, …
+    pub index: usize,
+    /// Simulated time (s).
+    pub time: f64,
+    /// Time steps taken so far.
+    pub steps: usize,
+    /// The energies of the points.
+    pub energies: Energies,
+    /// The points: positions, displacements, velocities, Cauchy stresses,
+    /// deformation gradients, volumes, plastic strains, with the
+    /// [`Checkpoint`] when the run was asked for one
+    /// ([`RunControl::checkpoint`]).
+    pub snapshot: &'a Snapshot,
+}
+
+/// The observer of an explicit run: sees every step and every output; an
+/// error stops the run (e.g. `SolverError::Stopped` after a budget of
+/// outputs).
+pub type ExplicitObserver<'a> = dyn FnMut(ExplicitEvent<'_>) -> Result<(), SolverError> + 'a;
+
+/// What an explicit run produced.
+#[derive(Debug, Clone)]
+pub struct ExplicitOutput {
+    /// The final state.
+    pub last: Snapshot,
+    /// Time steps taken (including those before a resumed checkpoint).
+    pub steps: usize,
+    /// The time reached (s).
+    pub time: f64,
+    /// Outputs written, the initial state included.
+    pub outputs: usize,
+    /// The energies at t = 0.
+    pub initial: Energies,
+    /// The energies at the end.
+    pub last_energies: Energies,
+    /// The largest kinetic + strain energy seen at the outputs: the scale
+    /// of [`Self::energy_drift`].
+    pub energy_scale: f64,
+    /// The relative drift of the total energy,
+    /// (total(end) − total(0)) / [`Self::energy_scale`]: independent of
+    /// the datum of the gravitational energy, zero for a conservative
+    /// scheme (0 when nothing moves).
+    pub energy_drift: f64,
+    /// Solver wall time in seconds (observer time excluded), including the
+    /// time before a resumed checkpoint.
+    pub wall_time_s: f64,
+    /// Wall time per stage of this session's steps.
+    pub stage_times: ExplicitStageTimes,
+}
+
+/// A scene problem whose explicit run is compiled here: implemented for
+/// two and three dimensions, each the one place where that dimension's
+/// explicit solvers are monomorphised.
+pub trait RunExplicit<const D: usize> {
+    /// Runs the problem's explicit setup.
+    ///
+    /// # Errors
+    /// As [`run_explicit`].
+    fn run_explicit(
+        &self,
+        control: &RunControl,
+        observer: &mut ExplicitObserver<'_>,
+    ) -> Result<ExplicitOutput, SolverError>;
+}
+
+macro_rules! run_explicit_in {
+    ($($d:literal),*) => {$(
+        impl RunExplicit<$d> for Problem<$d> {
+            #[inline(never)]
+            fn run_explicit(
+                &self,
+                control: &RunControl,
+                observer: &mut ExplicitObserver<'_>,
+            ) -> Result<ExplicitOutput, SolverError> {
+                dispatch(self, control, observer)
+            }
+        }
+    )*};
+}
+
+run_explicit_in!(2, 3);
+
+/// Runs a problem built from a scene with `[solver] kind = "explicit"`;
+/// `observer` sees every step and every output (the initial state first,
+/// unless resumed).
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] for a problem without an explicit setup
+/// or off a grid, a checkpoint of another scene;
+/// [`SolverError::ExplicitPoint`] when a point leaves the grid, inverts
+/// or its stress update fails; the observer's error.
+pub fn run_explicit<const D: usize, O>(
+    problem: &Problem<D>,
+    control: &RunControl,
+    mut observer: O,
+) -> Result<ExplicitOutput, SolverError>
+where
+    Problem<D>: RunExplicit<D>,
+    O: FnMut(ExplicitEvent<'_>) -> Result<(), SolverError>,
+{
+    problem.run_explicit(control, &mut observer)
+}
+
+/// The problem's grid and setup, or why it has none.
+fn parts<const D: usize>(
+    problem: &Problem<D>,
+) -> Result<(&RegularGrid<D>, &ExplicitSetup<D>), SolverError> {
+    let setup = problem.explicit.as_ref().ok_or_else(|| {
+        SolverError::InvalidInput("the scene's solver is implicit: run it with scene::run".into())
+    })?;
+    match &problem.mesh {
+        SceneMesh::Grid(grid) => Ok((grid, setup)),
+        SceneMesh::Simplex(_) => Err(SolverError::InvalidInput(
+            "the explicit solver runs on regular grids".into(),
+        )),
+    }
+}
+
+/// The basis.
+fn dispatch<const D: usize>(
+    problem: &Problem<D>,
+    control: &RunControl,
+    observer: &mut ExplicitObserver<'_>,
+) -> Result<ExplicitOutput, SolverError> {
+    parts(problem)?;
+    let run = Run {
+        problem,
+        control,
+        observer,
+    };
+    match problem.variant.basis {
+        BasisKind::Linear => run.with_basis(LinearMpm),
+        BasisKind::BSpline2 => run.with_basis(QuadraticBSpline),
+        other => Err(SolverError::InvalidInput(format!(
+            "basis = {other} has no domain update in time; the explicit solver takes linear or bspline2"
+        ))),
+    }
+}
+
+struct Run<'a, 'o, const D: usize> {
+    problem: &'a Problem<D>,
+    control: &'a RunControl,
+    observer: &'a mut ExplicitObserver<'o>,
+}
+
+impl<const D: usize> Run<'_, '_, D> {
+    /// The law (one material per explicit scene).
+    fn with_basis<B>(self, basis: B) -> Result<ExplicitOutput, SolverError>
+    where
+        B: BasisFunction<D, Domain = (), Mesh = RegularGrid<D>>,
+    {
+        let Some(material) = self.problem.materials.first() else {
+            return Err(SolverError::InvalidInput(
+                "the scene has no material".into(),
+            ));
+        };
+        let p = &material.params;
+        let (e, nu) = (p.youngs_modulus, p.poisson_ratio);
+        match material.model {
+            MaterialModel::NeoHookean => self.with_law(basis, NeoHookean::new(e, nu)?),
+            MaterialModel::Hencky => {
+                self.with_law(basis, Spectral::new(HenckyElastic::new(e, nu)?)?)
+            }
+            MaterialModel::VonMises => {
+                let yield_stress = p.yield_stress.ok_or_else(|| {
+                    SolverError::InvalidInput("material = von_mises needs yield_stress".into())
+                })?;
+                self.with_law(
+                    basis,
+                    Spectral::new(VonMises::new(e, nu, yield_stress, p.hardening)?)?,
+                )
+            }
+        }
+    }
+
+    /// The transfer.
+    fn with_law<B, L>(self, basis: B, law: L) -> Result<ExplicitOutput, SolverError>
+    where
+        B: BasisFunction<D, Domain = (), Mesh = RegularGrid<D>>,
+        L: IncrementalLaw,
+        L::State: FlatState,
+    {
+        let (_, setup) = parts(self.problem)?;
+        let alpha = setup.alpha;
+        match setup.transfer {
+            TransferKind::Pic | TransferKind::Flip | TransferKind::Blend => {
+                self.with_transfer(basis, law, FlipPic { alpha })
+            }
+            TransferKind::Tpic | TransferKind::Tflip => {
+                self.with_transfer(basis, law, Taylor { alpha })
+            }
+        }
+    }
+
+    /// The dilatation treatment.
+    fn with_transfer<B, L, T>(
+        self,
+        basis: B,
+        law: L,
+        transfer: T,
+    ) -> Result<ExplicitOutput, SolverError>
+    where
+        B: BasisFunction<D, Domain = (), Mesh = RegularGrid<D>>,
+        L: IncrementalLaw,
+        L::State: FlatState,
+        T: Transfer<D>,
+        T::PointState: FlatState,
+    {
+        let (_, setup) = parts(self.problem)?;
+        match setup.locking {
+            LockingKind::None => self.with(basis, law, transfer, NoLocking),
+            LockingKind::CellAveraged => self.with(basis, law, transfer, CellAveraged),
+            other => Err(SolverError::InvalidInput(format!(
+                "locking = {other} is an implicit treatment; the explicit solver takes none or cell_averaged"
+            ))),
+        }
+    }
+
+    /// Runs with every type chosen.
+    fn with<B, L, T, K>(
+        self,
+        basis: B,
+        law: L,
+        transfer: T,
+        locking: K,
+    ) -> Result<ExplicitOutput, SolverError>
+    where
+        B: BasisFunction<D, Domain = (), Mesh = RegularGrid<D>>,
+        L: IncrementalLaw,
+        L::State: FlatState,
+        T: Transfer<D>,
+        T::PointState: FlatState,
+        K: DilatationTreatment,
+    {
+        let (grid, setup) = parts(self.problem)?;
+        let problem = self.problem;
+        let options = ExplicitOptions {
+            time_step: setup.time_step,
+            gravity: setup.gravity,
+        };
+        let mut solver = ExplicitSolver::new(
+            basis,
+            grid.clone(),
+            law,
+            transfer,
+            locking,
+            setup.fixities.clone(),
+            options,
+        )?;
+        let mut points: PointsFor<D, L, T> =
+            ExplicitPoints::new(problem.position.clone(), problem.volume.clone(), 1.0)?;
+        points.mass.clone_from(&problem.mass);
+        points.velocity.clone_from(&setup.velocity);
+        points.point_force.clone_from(&setup.point_forces);
+        if points.mass.len() != points.len() || points.velocity.len() != points.len() {
+            return Err(SolverError::InvalidInput(format!(
+                "{} points but {} masses and {} velocities",
+                points.len(),
+                points.mass.len(),
+                points.velocity.len()
+            )));
+        }
+        let initial_position = problem.position.clone();
+        let end_time = setup.end_time;
+        let outputs = output_count(end_time, setup.output_interval);
+        let output_time = |k: usize| {
+            if k >= outputs {
+                end_time
+            } else {
+                k as f64 * setup.output_interval
+            }
+        };
+
+        let observer = self.observer;
+        let mut wall = Wall::default();
+        let mut clock = match &self.control.resume {
+            Some(c) => {
+                let clock = Clock::from_checkpoint(c)?;
+                points = read_points::<D, L::State, T::PointState>(&c.points, points)?;
+                solver.resume_at(
+                    c.state.load_factor,
+                    c.state.summary.steps,
+                    clock.external_work,
+                );
+                wall.earlier = c.wall_time_s;
+                clock
+            }
+            None => {
+                let initial = solver.energies(&points)?;
+                let clock = Clock {
+                    index: 0,
+                    external_work: 0.0,
+                    initial,
+                    scale: initial.kinetic + initial.strain,
+                };
+                let so_far = wall.so_far();
+                wall.observe(|| {
+                    let snapshot = snapshot(
+                        &points,
+                        &initial_position,
+                        0.0,
+                        self.control,
+                        0,
+                        &clock,
+                        so_far,
+                    );
+                    observer(ExplicitEvent::Output(ExplicitFrame {
+                        index: 0,
+                        time: 0.0,
+                        steps: 0,
+                        energies: initial,
+                        snapshot: &snapshot,
+                    }))
+                })?;
+                clock
+            }
+        };
+        let session_start = *solver.stage_times();
+        while clock.index < outputs {
+            let target = output_time(clock.index + 1);
+            solver.run_until(&mut points, target, |_, _, info| {
+                wall.observe(|| observer(ExplicitEvent::Step(*info)))
+            })?;
+            let energies = solver.energies(&points)?;
+            clock.index += 1;
+            clock.external_work = solver.external_work();
+            clock.scale = clock.scale.max(energies.kinetic + energies.strain);
+            let time = solver.time();
+            let so_far = wall.so_far();
+            wall.observe(|| {
+                let snapshot = snapshot(
+                    &points,
+                    &initial_position,
+                    time,
+                    self.control,
+                    solver.steps(),
+                    &clock,
+                    so_far,
+                );
+                observer(ExplicitEvent::Output(ExplicitFrame {
+                    index: clock.index,
+                    time,
+                    steps: solver.steps(),
+                    energies,
+                    snapshot: &snapshot,
+                }))
+            })?;
+        }
+        let last_energies = solver.energies(&points)?;
+        let scale = clock.scale;
+        let drift = last_energies.total() - clock.initial.total();
+        let stage = solver.stage_times();
+        Ok(ExplicitOutput {
+            last: snapshot_of(&points, &initial_position, solver.time()),
+            steps: solver.steps(),
+            time: solver.time(),
+            outputs: outputs + 1,
+            initial: clock.initial,
+            last_energies,
+            energy_scale: scale,
+            energy_drift: if scale > 0.0 { drift / scale } else { 0.0 },
+            wall_time_s: wall.so_far(),
+            stage_times: ExplicitStageTimes {
+                p2g: stage.p2g - session_start.p2g,
+                grid: stage.grid - session_start.grid,
+                g2p: stage.g2p - session_start.g2p,
+            },
+        })
+    }
+}
+
+/// Outputs after the initial state: `end_time / interval` rounded up (an
+/// interval that divides the end time to rounding gives no sliver).
+fn output_count(end_time: f64, interval: f64) -> usize {
+    let n = end_time / interval;
+    let rounded = n.round();
+    if (n - rounded).abs() <= 1e-9 * n.max(1.0) {
+        (rounded as usize).max(1)
+    } else {
+        (n.ceil() as usize).max(1)
+    }
+}
+
+/// Solver wall time: total elapsed minus the observer's share, plus the
+/// time before a resumed checkpoint.
+struct Wall {
+    start: Instant,
+    observer: f64,
+    earlier: f64,
+}
+
+impl Default for Wall {
+    fn default() -> Self {
+        Self {
+            start: Instant::now(),
+            observer: 0.0,
+            earlier: 0.0,
+        }
+    }
+}
+
+impl Wall {
+    fn so_far(&self) -> f64 {
+        self.earlier + self.start.elapsed().as_secs_f64() - self.observer
+    }
+
+    /// Runs `f` and books its time to the observer.
+    fn observe<R>(&mut self, f: impl FnOnce() -> R) -> R {
+        let t = Instant::now();
+        let r = f();
+        self.observer += t.elapsed().as_secs_f64();
+        r
+    }
+}
+
+/// What an explicit checkpoint keeps besides the points and the step
+/// count: the output reached, the work of the applied forces, the initial
+/// energies and the energy scale (in [`Checkpoint::case_state`]).
+#[derive(Debug, Clone, Copy)]
+struct Clock {
+    index: usize,
+    external_work: f64,
+    initial: Energies,
+    scale: f64,
+}
+
+impl Clock {
+    const LEN: usize = 7;
+
+    fn to_case_state(self) -> Vec<f64> {
+        let e = self.initial;
+        vec![
+            self.index as f64,
+            self.external_work,
+            e.kinetic,
+            e.strain,
+            e.gravitational,
+            e.external_work,
+            self.scale,
+        ]
+    }
+
+    fn from_checkpoint(c: &Checkpoint) -> Result<Self, SolverError> {
+        let s = &c.case_state;
+        if s.len() != Self::LEN || !(s[0] >= 0.0 && s[0].fract() == 0.0) {
+            return Err(SolverError::InvalidInput(
+                "the checkpoint was not written by an explicit run of this scene".into(),
+            ));
+        }
+        Ok(Self {
+            index: s[0] as usize,
+            external_work: s[1],
+            initial: Energies {
+                kinetic: s[2],
+                strain: s[3],
+                gravitational: s[4],
+                external_work: s[5],
+            },
+            scale: s[6],
+        })
+    }
+}
+
+/// A snapshot of the points after `steps` steps, with a checkpoint when
+/// the run keeps them.
+fn snapshot<const D: usize, S: FlatState, T: FlatState>(
+    points: &ExplicitPoints<D, S, T>,
+    initial: &[SVector<f64, D>],
+    time: f64,
+    control: &RunControl,
+    steps: usize,
+    clock: &Clock,
+    wall_time_s: f64,
+) -> Snapshot {
+    let mut snap = snapshot_of(points, initial, time);
+    if control.checkpoint {
+        snap.checkpoint = Some(Checkpoint {
+            state: RunState {
+                load_factor: time,
+                increment: 0.0,
+                summary: RunSummary {
+                    steps,
+                    cut_steps: 0,
+                    iterations: 0,
+                },
+            },
+            predictor: None,
+            points: write_points(points),
+            wall_time_s,
+            case_state: clock.to_case_state(),
+        });
+    }
+    snap
+}
+
+/// The points as plain arrays: positions, displacements from `initial`,
+/// velocities, Cauchy stresses, deformation gradients, volumes, plastic
+/// strains.
+fn snapshot_of<const D: usize, S: FlatState, T: FlatState>(
+    points: &ExplicitPoints<D, S, T>,
+    initial: &[SVector<f64, D>],
+    time: f64,
+) -> Snapshot {
+    let pad = |x: &SVector<f64, D>| std::array::from_fn(|i| if i < D { x[i] } else { 0.0 });
+    let flat = |m: &Matrix3<f64>| std::array::from_fn(|k| m[(k / 3, k % 3)]);
+    Snapshot {
+        load_factor: time,
+        position: points.position.iter().map(pad).collect(),
+        displacement: points
+            .position
+            .iter()
+            .zip(initial)
+            .map(|(x, x0)| pad(&(x - x0)))
+            .collect(),
+        velocity: points.velocity.iter().map(pad).collect(),
+        sigma: (0..points.len()).map(|p| flat(&points.cauchy(p))).collect(),
+        f: points.f.iter().map(flat).collect(),
+        volume: points.volume.clone(),
+        plastic_strain: points
+            .material
+            .iter()
+            .map(FlatState::plastic_strain)
+            .collect(),
+        ..Snapshot::default()
+    }
+}
+
+/// A per-point state stored in a checkpoint as exactly [`FlatState::LEN`]
+/// numbers: the laws' states ($b^e$ and the history) and the transfers'
+/// (nothing, or the velocity gradient).
+pub trait FlatState: Copy + Default + Send + Sync + std::fmt::Debug + PartialEq + 'static {
+    /// Numbers per value.
+    const LEN: usize;
+    /// Appends the value's numbers to `out`.
+    fn write(&self, out: &mut Vec<f64>);
+    /// Reads a value from exactly [`FlatState::LEN`] numbers.
+    fn read(from: &[f64]) -> Self;
+    /// Equivalent plastic strain of a law's state (0 otherwise).
+    fn plastic_strain(&self) -> f64 {
+        0.0
+    }
+}
+
+impl<H> FlatState for MaterialState<H>
+where
+    H: Flat + HistoryOutput + Copy + Default + Send + Sync + std::fmt::Debug + PartialEq + 'static,
+{
+    const LEN: usize = 9 + H::LEN;
+    fn write(&self, out: &mut Vec<f64>) {
+        out.extend_from_slice(self.be.as_slice());
+        self.history.write(out);
+    }
+    fn read(from: &[f64]) -> Self {
+        Self {
+            be: Matrix3::from_column_slice(&from[..9]),
+            history: H::read(&from[9..]),
+        }
+    }
+    fn plastic_strain(&self) -> f64 {
+        self.history.equivalent_plastic_strain()
+    }
+}
+
+impl FlatState for () {
+    const LEN: usize = 0;
+    fn write(&self, _: &mut Vec<f64>) {}
+    fn read(_: &[f64]) -> Self {}
+}
+
+impl<const D: usize> FlatState for VelocityGradient<D> {
+    const LEN: usize = D * D;
+    fn write(&self, out: &mut Vec<f64>) {
+        out.extend_from_slice(self.0.as_slice());
+    }
+    fn read(from: &[f64]) -> Self {
+        Self(nalgebra::SMatrix::from_column_slice(&from[..D * D]))
+    }
+}
+
+/// Numbers per point of [`write_points`].
+fn point_len<const D: usize, S: FlatState, T: FlatState>() -> usize {
+    2 * D + 3 + 18 + S::LEN + T::LEN
+}
+
+/// The points' evolving state as numbers: the count, then per point its
+/// position, velocity, mass, initial and current volume, F, τ, the law's
+/// and the transfer's state. Point forces are the scene's and not stored.
+fn write_points<const D: usize, S: FlatState, T: FlatState>(
+    points: &ExplicitPoints<D, S, T>,
+) -> Vec<f64> {
+    let n = points.len();
+    let mut out = Vec::with_capacity(1 + n * point_len::<D, S, T>());
+    out.push(n as f64);
+    for p in 0..n {
+        out.extend_from_slice(points.position[p].as_slice());
+        out.extend_from_slice(points.velocity[p].as_slice());
+        out.extend([points.mass[p], points.volume0[p], points.volume[p]]);
+        out.extend_from_slice(points.f[p].as_slice());
+        out.extend_from_slice(points.tau[p].as_slice());
+        points.material[p].write(&mut out);
+        points.transfer[p].write(&mut out);
+    }
+    out
+}
+
+/// [`write_points`] read back into `points` (the scene's points, which
+/// keep their point forces).
+fn read_points<const D: usize, S: FlatState, T: FlatState>(
+    flat: &[f64],
+    mut points: ExplicitPoints<D, S, T>,
+) -> Result<ExplicitPoints<D, S, T>, SolverError> {
+    let n = points.len();
+    let per = point_len::<D, S, T>();
+    if flat.first() != Some(&(n as f64)) || flat.len() != 1 + n * per {
+        return Err(SolverError::InvalidInput(format!(
+            "the checkpoint holds {} numbers, {n} points of this scene's explicit run take {}",
+            flat.len(),
+            1 + n * per
+        )));
+    }
+    for (p, chunk) in flat[1..].chunks_exact(per).enumerate() {
+        let (x, rest) = chunk.split_at(D);
+        let (v, rest) = rest.split_at(D);
+        points.position[p] = SVector::from_column_slice(x);
+        points.velocity[p] = SVector::from_column_slice(v);
+        points.mass[p] = rest[0];
+        points.volume0[p] = rest[1];
+        points.volume[p] = rest[2];
+        let rest = &rest[3..];
+        points.f[p] = Matrix3::from_column_slice(&rest[..9]);
+        points.tau[p] = Matrix3::from_column_slice(&rest[9..18]);
+        let rest = &rest[18..];
+        points.material[p] = S::read(&rest[..S::LEN]);
+        points.transfer[p] = T::read(&rest[S::LEN..]);
+    }
+    Ok(points)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector2;
+
+    #[test]
+    fn output_times_end_at_the_end_time_without_slivers() {
+        assert_eq!(output_count(1.0, 0.05), 20);
+        assert_eq!(output_count(3.0, 0.1), 30);
+        assert_eq!(output_count(1.0, 0.3), 4);
+        assert_eq!(output_count(1.0, 5.0), 1);
+    }
+
+    #[test]
+    fn points_survive_their_flat_form() {
+        type S = MaterialState<mpm_constitutive::VonMisesHistory>;
+        let mut points: ExplicitPoints<2, S, VelocityGradient<2>> = ExplicitPoints::new(
+            vec![Vector2::new(0.1, 0.2), Vector2::new(0.3, 0.4)],
+            vec![0.5, 0.25],
+            2.0,
+        )
+        .expect("points");
+        points.velocity[1] = Vector2::new(-1.0, 2.0);
+        points.f[0][(0, 1)] = 0.1;
+        points.tau[1][(2, 2)] = 5.0;
+        points.material[1].history.alpha = 0.01;
+        points.material[0].be[(1, 1)] = 1.1;
+        points.transfer[1] = VelocityGradient(nalgebra::Matrix2::new(1.0, 2.0, 3.0, 4.0));
+        let flat = write_points(&points);
+        let fresh: ExplicitPoints<2, S, VelocityGradient<2>> =
+            ExplicitPoints::new(vec![Vector2::zeros(); 2], vec![1.0; 2], 1.0).expect("points");
+        let back = read_points(&flat, fresh).expect("read");
+        assert_eq!(back.position, points.position);
+        assert_eq!(back.velocity, points.velocity);
+        assert_eq!(back.mass, points.mass);
+        assert_eq!(back.f, points.f);
+        assert_eq!(back.tau, points.tau);
+        assert_eq!(back.material, points.material);
+        assert_eq!(back.transfer, points.transfer);
+        let short = ExplicitPoints::<2, S, VelocityGradient<2>>::new(
+            vec![SVector::zeros(); 3],
+            vec![1.0; 3],
+            1.0,
+        )
+        .expect("points");
+        assert!(read_points(&flat, short).is_err());
+    }
+}
