@@ -2,21 +2,10 @@
 #![allow(clippy::unwrap_used)]
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 mod common;
 
-fn mpm(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_mpm"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::{mpm, run_outputs as outputs};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mpm-cli-{name}-{}", std::process::id()));
@@ -230,25 +219,6 @@ fn non_convergence_and_points_leaving_the_grid_are_diagnosed() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Every file of `dir` except the checkpoint and `summary.json` (whose wall
-/// time differs), by name.
-fn outputs(dir: &Path) -> std::collections::BTreeMap<String, String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| {
-            let name = p.file_name().unwrap().to_str().unwrap();
-            name != "checkpoint.mpm" && name != "summary.json"
-        })
-        .map(|p| {
-            (
-                p.file_name().unwrap().to_str().unwrap().to_string(),
-                std::fs::read_to_string(&p).unwrap(),
-            )
-        })
-        .collect()
-}
-
 #[test]
 fn resume_repeats_the_uninterrupted_run() {
     // The shear case uses the secant predictor, whose memory must survive
@@ -292,8 +262,8 @@ fn resume_repeats_the_uninterrupted_run() {
             // Wall-clock columns differ between any two runs.
             let (x, y) = if name.ends_with("steps.csv") {
                 (
-                    common::without_timings(text),
-                    common::without_timings(&b[name]),
+                    common::without_timings(&String::from_utf8_lossy(text)).into_bytes(),
+                    common::without_timings(&String::from_utf8_lossy(&b[name])).into_bytes(),
                 )
             } else {
                 (text.clone(), b[name].clone())

@@ -6,8 +6,9 @@
 
 mod common;
 
+use common::mpm;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use mpm_cases::run::{RunControl, Snapshot};
 use mpm_cases::scene::{self, ExplicitEvent, ExplicitOutput, Problem};
@@ -259,18 +260,6 @@ fn the_cube_falls_freely_then_bounces_on_the_floor() {
     assert!(out.energy_drift < 0.0);
 }
 
-fn mpm(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_mpm"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 fn scene_path(file: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../scenes")
@@ -389,22 +378,7 @@ fn an_explicit_run_resumes_bit_for_bit() {
     assert!(ok && out.contains("stopped after output 9"), "{out}{err}");
     let (ok, _, err) = run(&split, &["--resume"]);
     assert!(ok, "{err}");
-    let files = |dir: &Path| -> std::collections::BTreeMap<String, Vec<u8>> {
-        std::fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| {
-                let name = p.file_name().unwrap().to_str().unwrap();
-                name != "checkpoint.mpm" && name != "summary.json"
-            })
-            .map(|p| {
-                (
-                    p.file_name().unwrap().to_str().unwrap().to_string(),
-                    std::fs::read(&p).unwrap(),
-                )
-            })
-            .collect()
-    };
+    let files = common::run_outputs;
     let (a, b) = (files(&whole), files(&split));
     assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
     assert!(a.contains_key("final.png") && a.contains_key("energy.csv"));

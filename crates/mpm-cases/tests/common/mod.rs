@@ -150,3 +150,35 @@ pub fn without_timings(csv: &str) -> String {
         .collect::<Vec<_>>()
         .join("\n")
 }
+
+/// Runs the `mpm` binary with `args`: (success, stdout, stderr).
+pub fn mpm(args: &[&str]) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Every file of the run directory `dir` except the checkpoint and
+/// `summary.json` (whose wall time differs), by name, as bytes.
+pub fn run_outputs(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let name = p.file_name().unwrap().to_str().unwrap();
+            name != "checkpoint.mpm" && name != "summary.json"
+        })
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_str().unwrap().to_string(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect()
+}
