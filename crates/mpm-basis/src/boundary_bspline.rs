@@ -5,8 +5,8 @@ use mpm_mesh::RegularGrid;
 use nalgebra::SVector;
 
 use crate::quadratic_bspline::QuadraticBSpline;
-use crate::tensor::{AxisFactors, tensor_factors, tensor_product, visit_product};
-use crate::{BasisError, BasisFunction, Stencil, TensorFactors};
+use crate::tensor::AxisFactors;
+use crate::{BasisError, BasisFunction, Stencil};
 
 /// The uniform quadratic B-spline of [`QuadraticBSpline`] away from the
 /// grid boundary, modified within half a cell of it so that the basis
@@ -76,43 +76,7 @@ impl<const D: usize> BasisFunction<D> for BoundaryBSpline {
 
     fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
 
-    fn evaluate(
-        &self,
-        mesh: &RegularGrid<D>,
-        position: &SVector<f64, D>,
-        _domain: &(),
-        out: &mut Stencil<D>,
-    ) -> Result<(), BasisError> {
-        out.clear();
-        let axes = Self::axis_factors(mesh, position)?;
-        tensor_product(mesh, &axes, out)
-    }
-
-    #[inline]
-    fn tensor_factors(
-        &self,
-        mesh: &RegularGrid<D>,
-        position: &SVector<f64, D>,
-        _domain: &(),
-    ) -> Option<Result<TensorFactors<D>, BasisError>> {
-        match Self::axis_factors(mesh, position) {
-            Ok(axes) => tensor_factors(mesh, position, &axes).map(Ok),
-            Err(e) => Some(Err(e)),
-        }
-    }
-
-    #[inline]
-    fn for_each_node(
-        &self,
-        mesh: &RegularGrid<D>,
-        position: &SVector<f64, D>,
-        _domain: &(),
-        _scratch: &mut Stencil<D>,
-        visit: impl FnMut(usize, f64, &SVector<f64, D>),
-    ) -> Result<(), BasisError> {
-        let axes = Self::axis_factors(mesh, position)?;
-        visit_product(mesh, &axes, visit)
-    }
+    crate::tensor::tensor_basis_methods!(|mesh, position| Self::axis_factors(mesh, position));
 }
 
 #[cfg(test)]

@@ -4,8 +4,8 @@
 use mpm_mesh::RegularGrid;
 use nalgebra::SVector;
 
-use crate::tensor::{AxisFactors, tensor_factors, tensor_product, visit_product};
-use crate::{BasisError, BasisFunction, Stencil, TensorFactors};
+use crate::tensor::AxisFactors;
+use crate::{BasisError, BasisFunction, Stencil};
 
 /// The standard material point method basis: $S_{vp} = N_v(\mathbf x_p)$,
 /// $\nabla S_{vp} = \nabla N_v(\mathbf x_p)$ with $N_v$ the bilinear (2D) /
@@ -37,41 +37,7 @@ impl<const D: usize> BasisFunction<D> for LinearMpm {
 
     fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
 
-    fn evaluate(
-        &self,
-        mesh: &RegularGrid<D>,
-        position: &SVector<f64, D>,
-        _domain: &(),
-        out: &mut Stencil<D>,
-    ) -> Result<(), BasisError> {
-        out.clear();
-        tensor_product(mesh, &axis_factors(mesh, position)?, out)
-    }
-
-    #[inline]
-    fn tensor_factors(
-        &self,
-        mesh: &RegularGrid<D>,
-        position: &SVector<f64, D>,
-        _domain: &(),
-    ) -> Option<Result<TensorFactors<D>, BasisError>> {
-        match axis_factors(mesh, position) {
-            Ok(axes) => tensor_factors(mesh, position, &axes).map(Ok),
-            Err(e) => Some(Err(e)),
-        }
-    }
-
-    #[inline]
-    fn for_each_node(
-        &self,
-        mesh: &RegularGrid<D>,
-        position: &SVector<f64, D>,
-        _domain: &(),
-        _scratch: &mut Stencil<D>,
-        visit: impl FnMut(usize, f64, &SVector<f64, D>),
-    ) -> Result<(), BasisError> {
-        visit_product(mesh, &axis_factors(mesh, position)?, visit)
-    }
+    crate::tensor::tensor_basis_methods!(|mesh, position| axis_factors(mesh, position));
 }
 
 /// The two 1D hat factors per axis of the point at `position`.

@@ -3,8 +3,8 @@
 use mpm_mesh::RegularGrid;
 use nalgebra::SVector;
 
-use crate::tensor::{AxisFactors, tensor_factors, tensor_product, visit_product};
-use crate::{BasisError, BasisFunction, Stencil, TensorFactors};
+use crate::tensor::AxisFactors;
+use crate::{BasisError, BasisFunction, Stencil};
 
 /// Uniform quadratic B-spline basis (Steffen et al. 2008; MPoint theory
 /// notes eqs. 24–27), one spline centred at every grid node:
@@ -62,43 +62,7 @@ impl<const D: usize> BasisFunction<D> for QuadraticBSpline {
 
     fn initial_domain(_: &SVector<f64, D>, _: &SVector<f64, D>) {}
 
-    fn evaluate(
-        &self,
-        mesh: &RegularGrid<D>,
-        position: &SVector<f64, D>,
-        _domain: &(),
-        out: &mut Stencil<D>,
-    ) -> Result<(), BasisError> {
-        out.clear();
-        let axes = Self::axis_factors(mesh, position)?;
-        tensor_product(mesh, &axes, out)
-    }
-
-    #[inline]
-    fn tensor_factors(
-        &self,
-        mesh: &RegularGrid<D>,
-        position: &SVector<f64, D>,
-        _domain: &(),
-    ) -> Option<Result<TensorFactors<D>, BasisError>> {
-        match Self::axis_factors(mesh, position) {
-            Ok(axes) => tensor_factors(mesh, position, &axes).map(Ok),
-            Err(e) => Some(Err(e)),
-        }
-    }
-
-    #[inline]
-    fn for_each_node(
-        &self,
-        mesh: &RegularGrid<D>,
-        position: &SVector<f64, D>,
-        _domain: &(),
-        _scratch: &mut Stencil<D>,
-        visit: impl FnMut(usize, f64, &SVector<f64, D>),
-    ) -> Result<(), BasisError> {
-        let axes = Self::axis_factors(mesh, position)?;
-        visit_product(mesh, &axes, visit)
-    }
+    crate::tensor::tensor_basis_methods!(|mesh, position| Self::axis_factors(mesh, position));
 }
 
 impl QuadraticBSpline {

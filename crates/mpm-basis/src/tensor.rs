@@ -72,6 +72,66 @@ pub struct TensorFactors<const D: usize> {
     pub spacing: [f64; D],
 }
 
+impl<const D: usize> TensorFactors<D> {
+    /// Id of the node with the highest index on every axis (the largest
+    /// id of the stencil).
+    #[inline]
+    pub fn last_id(&self) -> usize {
+        self.first_id
+            + (0..D)
+                .map(|i| self.len[i].saturating_sub(1) * self.strides[i])
+                .sum::<usize>()
+    }
+}
+
+/// The three methods shared by the point-domain tensor-product bases
+/// (`Domain = ()`, `Mesh = RegularGrid<D>`): `evaluate`, `tensor_factors`
+/// and `for_each_node`, each from the basis's per-axis factors, given as
+/// an expression in `mesh` and `position` of type
+/// `Result<[AxisFactors<K>; D], BasisError>`.
+macro_rules! tensor_basis_methods {
+    (|$mesh:ident, $position:ident| $factors:expr) => {
+        fn evaluate(
+            &self,
+            $mesh: &RegularGrid<D>,
+            $position: &SVector<f64, D>,
+            _domain: &(),
+            out: &mut Stencil<D>,
+        ) -> Result<(), BasisError> {
+            out.clear();
+            let axes = $factors?;
+            $crate::tensor::tensor_product($mesh, &axes, out)
+        }
+
+        #[inline]
+        fn tensor_factors(
+            &self,
+            $mesh: &RegularGrid<D>,
+            $position: &SVector<f64, D>,
+            _domain: &(),
+        ) -> Option<Result<$crate::TensorFactors<D>, BasisError>> {
+            match $factors {
+                Ok(axes) => $crate::tensor::tensor_factors($mesh, $position, &axes).map(Ok),
+                Err(e) => Some(Err(e)),
+            }
+        }
+
+        #[inline]
+        fn for_each_node(
+            &self,
+            $mesh: &RegularGrid<D>,
+            $position: &SVector<f64, D>,
+            _domain: &(),
+            _scratch: &mut Stencil<D>,
+            visit: impl FnMut(usize, f64, &SVector<f64, D>),
+        ) -> Result<(), BasisError> {
+            let axes = $factors?;
+            $crate::tensor::visit_product($mesh, &axes, visit)
+        }
+    };
+}
+pub(crate) use tensor_basis_methods;
+
 /// The [`TensorFactors`] of per-axis factors of at most 3 consecutive
 /// nodes, or `None` when the factors are not consecutive (the solver then
 /// uses the general path).

@@ -174,6 +174,20 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
         self.writer
             .step(step, report, snap)
             .map_err(observer_error)?;
+        self.write_checkpoint(snap)?;
+        self.steps += 1;
+        if self.stop_after.is_some_and(|n| self.steps >= n) && report.lambda1 < 1.0 {
+            self.bar.finish_and_clear();
+            return Err(SolverError::Stopped {
+                step: step + 1,
+                load_factor: report.lambda1,
+            });
+        }
+        Ok(())
+    }
+
+    /// Writes the checkpoint the snapshot carries, if any.
+    fn write_checkpoint(&self, snap: &Snapshot) -> Result<(), SolverError> {
         if let Some(c) = &snap.checkpoint {
             checkpoint::write(
                 self.writer.dir(),
@@ -183,14 +197,6 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
                 self.writer.state(),
             )
             .map_err(observer_error)?;
-        }
-        self.steps += 1;
-        if self.stop_after.is_some_and(|n| self.steps >= n) && report.lambda1 < 1.0 {
-            self.bar.finish_and_clear();
-            return Err(SolverError::Stopped {
-                step: step + 1,
-                load_factor: report.lambda1,
-            });
         }
         Ok(())
     }
@@ -255,16 +261,7 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
         self.writer
             .output(index, time, snap)
             .map_err(observer_error)?;
-        if let Some(c) = &snap.checkpoint {
-            checkpoint::write(
-                self.writer.dir(),
-                &self.case,
-                self.parameters.clone(),
-                c,
-                self.writer.state(),
-            )
-            .map_err(observer_error)?;
-        }
+        self.write_checkpoint(snap)?;
         if index == 0 {
             return Ok(());
         }

@@ -131,8 +131,30 @@ where
         }
         obs.step(s, rep, snap)
     })?;
-    let mut results = Map::new();
+    let mut results = scene_results(problem, last_probes, &r.last, obs.writer.dir())?;
     results.insert("reactions".into(), Value::Object(last_reactions));
+    let s = summary(
+        "scene",
+        problem.variant,
+        problem.len(),
+        &r,
+        None,
+        results,
+        scene,
+    );
+    obs.finish(s)
+}
+
+/// The `results` of a scene's `summary.json` shared by both solvers: the
+/// last probe values, the bodies with their point counts and, when asked
+/// for, `final.png` of the final state `last` written in `dir`.
+fn scene_results<const D: usize>(
+    problem: &crate::scene::Problem<D>,
+    last_probes: Map<String, Value>,
+    last: &crate::run::Snapshot,
+    dir: &std::path::Path,
+) -> Result<Map<String, Value>, CasesError> {
+    let mut results = Map::new();
     results.insert("probes".into(), Value::Object(last_probes));
     results.insert(
         "bodies".into(),
@@ -145,19 +167,9 @@ where
         ),
     );
     if problem.png {
-        let png = write_png(problem, &r.last, obs.writer.dir())?;
-        results.insert("png".into(), png);
+        results.insert("png".into(), write_png(problem, last, dir)?);
     }
-    let s = summary(
-        "scene",
-        problem.variant,
-        problem.len(),
-        &r,
-        None,
-        results,
-        scene,
-    );
-    obs.finish(s)
+    Ok(results)
 }
 
 /// `final.png` of the final state `last` in `dir`: the points coloured by
@@ -315,22 +327,7 @@ where
         }
         other => other?,
     };
-    let mut results = Map::new();
-    results.insert("probes".into(), Value::Object(last_probes));
-    results.insert(
-        "bodies".into(),
-        json!(
-            problem
-                .bodies
-                .iter()
-                .map(|b| json!({"name": b.name, "material_points": b.points.len()}))
-                .collect::<Vec<_>>()
-        ),
-    );
-    if problem.png {
-        let png = write_png(problem, &r.last, obs.writer.dir())?;
-        results.insert("png".into(), png);
-    }
+    let results = scene_results(problem, last_probes, &r.last, obs.writer.dir())?;
     let summary = ExplicitSummary {
         case: "scene".into(),
         solver: "explicit".into(),

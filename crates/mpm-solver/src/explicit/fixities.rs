@@ -6,8 +6,8 @@
 /// wall fixes the normal component to zero; a clamp fixes all.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct VelocityFixities {
-    /// (node, component, velocity), sorted and without duplicates after
-    /// [`VelocityFixities::finish`].
+    /// (node, component, velocity), in the order given until
+    /// [`VelocityFixities::finish`] sorts them and drops repeats.
     entries: Vec<(usize, usize, f64)>,
 }
 
@@ -32,11 +32,13 @@ impl VelocityFixities {
     ) -> &mut Self {
         self.entries
             .extend(nodes.into_iter().map(|n| (n, component, velocity)));
-        self.finish();
         self
     }
 
-    fn finish(&mut self) {
+    /// Sorts the fixities by node and component, a later value of a
+    /// repeated component replacing the earlier one (the solver calls it
+    /// once when it takes the fixities; calling it again changes nothing).
+    pub fn finish(&mut self) {
         // Stable sort keeps the last value of a repeated component last.
         self.entries.sort_by_key(|&(n, c, _)| (n, c));
         let mut out: Vec<(usize, usize, f64)> = Vec::with_capacity(self.entries.len());
@@ -49,7 +51,8 @@ impl VelocityFixities {
         self.entries = out;
     }
 
-    /// The fixed components, sorted by node.
+    /// The fixed components: sorted by node and component after
+    /// [`VelocityFixities::finish`], in the order given before.
     pub fn entries(&self) -> &[(usize, usize, f64)] {
         &self.entries
     }
@@ -73,6 +76,7 @@ mod tests {
     fn later_values_replace_earlier_ones() {
         let mut f = VelocityFixities::new();
         f.fix([3, 1], 0).prescribe([3], 0, 2.0).fix([3], 1);
+        f.finish();
         assert_eq!(f.entries(), &[(1, 0, 0.0), (3, 0, 2.0), (3, 1, 0.0)]);
     }
 }

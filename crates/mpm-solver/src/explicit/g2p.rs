@@ -185,11 +185,7 @@ pub fn interpolate<const D: usize, B: mpm_basis::BasisFunction<D, Domain = ()>>(
             position: x.iter().copied().collect(),
             source: crate::error::BasisFailure::Basis(e),
         })?;
-        let last = t.first_id
-            + (0..D)
-                .map(|i| (t.len[i].max(1) - 1) * t.strides[i])
-                .sum::<usize>();
-        if last < node_count {
+        if t.last_id() < node_count {
             return Ok(super::tensor::gather_point(&t, grid));
         }
     }

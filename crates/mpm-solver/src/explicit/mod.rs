@@ -171,6 +171,8 @@ where
             )));
         }
         let node_count = mesh.node_count();
+        let mut fixities = fixities;
+        fixities.finish();
         if let Some(&(n, c, v)) = fixities
             .entries()
             .iter()

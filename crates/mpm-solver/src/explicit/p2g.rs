@@ -176,10 +176,7 @@ where
             let affine = T::affine(state);
             if !T::TAYLOR || affine.is_some() {
                 let t = factors.map_err(|e| (p, basis_failure(x, BasisFailure::Basis(e))))?;
-                let last = t.first_id
-                    + (0..D)
-                        .map(|i| (t.len[i].max(1) - 1) * t.strides[i])
-                        .sum::<usize>();
+                let last = t.last_id();
                 if last >= node_count {
                     return Err((
                         p,

@@ -40,6 +40,23 @@ pub fn block(
     (x, v)
 }
 
+/// $\sum_p (u_p - a\sin\beta X_p)^2$: the squared error of the axial
+/// displacements of `points` (started at `x0`) against the first mode of
+/// the bar at an instant where its amplitude is `a`.
+pub fn mode_squared_error<S, T>(
+    points: &ExplicitPoints<2, S, T>,
+    x0: &[Vector2<f64>],
+    a: f64,
+    beta: f64,
+) -> f64 {
+    points
+        .position
+        .iter()
+        .zip(x0)
+        .map(|(x, x0)| (x.x - x0.x - a * (beta * x0.x).sin()).powi(2))
+        .sum()
+}
+
 /// The result of [`vibrating_bar`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bar {
@@ -111,12 +128,8 @@ where
         let t_end = s as f64 * period * periods / samples as f64;
         solver.run_until(&mut points, t_end, |_, _, _| Ok(()))?;
         let t = solver.time();
-        for (p, x) in points.position.iter().enumerate() {
-            let u = x.x - x0[p].x;
-            let exact = amplitude * (omega * t).sin() * (beta * x0[p].x).sin();
-            sum += (u - exact).powi(2);
-            count += 1;
-        }
+        sum += mode_squared_error(&points, &x0, amplitude * (omega * t).sin(), beta);
+        count += points.len();
         let en = solver.energies(&points)?;
         energy.push((t, en.total()));
     }
@@ -334,11 +347,8 @@ pub fn fixed_end_bar<B: BasisFunction<2, Domain = (), Mesh = RegularGrid<2>>>(
     for s in 1..=8 {
         solver.run_until(&mut points, s as f64 * period / 8.0, |_, _, _| Ok(()))?;
         let t = solver.time();
-        for (p, x) in points.position.iter().enumerate() {
-            let exact = amplitude * (omega * t).sin() * (beta * x0[p].x).sin();
-            sum += (x.x - x0[p].x - exact).powi(2);
-            count += 1;
-        }
+        sum += mode_squared_error(&points, &x0, amplitude * (omega * t).sin(), beta);
+        count += points.len();
     }
     Ok((sum / count as f64).sqrt() / amplitude)
 }
