@@ -21,6 +21,14 @@
 //! - `reproduce locking`: Cook's membrane against refinement for standard
 //!   MPM, F-patch and F-bar, written to `docs/src/reproduction/locking.md`
 //!   ([`locking`]).
+//! - `stability [--quick]`: the stiff and extreme cases of issue 16, a
+//!   matrix of scenario × variant with measured outcomes, written to
+//!   `docs/src/reproduction/stability.md` ([`stability`]).
+//! - `report [--quick]`: every case with an analytic or published
+//!   reference, every variant that applies, error and wall time over a
+//!   refinement series, the cheapest variant per accuracy level and the
+//!   observed orders (issue 16), written to
+//!   `docs/src/reproduction/report.md` with a PNG per case ([`report`]).
 //! - `column-table`: error and solver time of the column for standard MPM
 //!   and GIMP (eq. 34), written to `docs/src/benchmarks/column.md`
 //!   ([`column_table`]).
@@ -41,7 +49,9 @@ mod mpoint;
 mod plate;
 mod plot;
 mod reference_values;
+mod report;
 mod scene_run;
+mod stability;
 mod vane;
 mod wang2021;
 
@@ -76,6 +86,21 @@ tasks:
                 dynamic collapse, elastic-cube throughput on 1 and 2 threads;
                 writes docs/src/reproduction/mpoint.md and its PNG plots.
                 --full adds the 128^3 cube.
+  stability [--quick]
+                the stiff and extreme cases (issue 16): nu x locking x formulation,
+                stiffness contrast 1e6, 10x/100x load steps, 360 degree rotation per
+                domain rule, stretches 0.05/20, points leaving the grid, inversion,
+                explicit dt beyond CFL, impacts, degenerate Gmsh meshes; writes
+                docs/src/reproduction/stability.md and stability.json.
+                --quick  the coarse matrix of the test suite
+  report [--quick]
+                every case with an analytic or published reference (column, shear,
+                annulus, stretch, Cook's membrane, Prandtl footing, vibrating bar,
+                colliding disks) over every variant that applies: error and wall time
+                per refinement level, error-against-time PNG per case, the fastest run
+                reaching each error level, observed convergence orders; writes
+                docs/src/reproduction/report.md and img/report-*.png (about 15 min).
+                --quick  coarse levels and a few variants per case (about a minute)
   column-table  error and run time of the column case, written to
                 docs/src/benchmarks/column.md
   reference-values
@@ -90,6 +115,22 @@ fn main() -> Result<()> {
         None | Some("help" | "--help" | "-h") => {
             println!("{USAGE}");
             Ok(())
+        }
+        Some("stability") => {
+            let mode = match &args[1..] {
+                [] => stability::Mode::Full,
+                [flag] if flag == "--quick" => stability::Mode::Quick,
+                [other, ..] => bail!("unexpected argument `{other}` (expected --quick)"),
+            };
+            stability::run(&docs_dir(), mode)
+        }
+        Some("report") => {
+            let mode = match &args[1..] {
+                [] => report::Mode::Full,
+                [flag] if flag == "--quick" => report::Mode::Quick,
+                [other, ..] => bail!("unexpected argument `{other}` (expected --quick)"),
+            };
+            report::run(&docs_dir(), mode)
         }
         Some("column-table") => {
             no_more_arguments(&args[1..])?;

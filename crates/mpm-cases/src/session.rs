@@ -83,6 +83,9 @@ impl Session {
         } else {
             (RunWriter::new(&self.out, grid)?, None)
         };
+        // Temporary files of a run killed mid-write are of no use to this
+        // one and must not outlive it.
+        crate::output::remove_temporaries(&self.out)?;
         let control = RunControl {
             checkpoint: true,
             resume,

@@ -179,6 +179,22 @@ pub enum SolverError {
     /// The locking treatment could not place the points in patches.
     #[error("locking treatment: {0}")]
     Locking(#[from] LockingError),
+    /// An error that stopped a load step without a retry (a point outside
+    /// the mesh, a domain that cannot be updated, a mesh that cannot
+    /// move, ...), with the step it stopped: the outputs of the steps
+    /// before it are complete.
+    #[error("load step {step} (load factor {load_factor} -> {target}): {source}")]
+    InStep {
+        /// Index of the step (counting converged steps from 0, as
+        /// [`SolverError::StepTooSmall`]).
+        step: usize,
+        /// Load factor at the start of the step.
+        load_factor: f64,
+        /// Load factor the step tried to reach.
+        target: f64,
+        /// What stopped it.
+        source: Box<SolverError>,
+    },
 }
 
 /// Why a locking treatment could not place the points in patches

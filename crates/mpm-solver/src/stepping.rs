@@ -165,7 +165,14 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                     };
                     observer(summary.steps - 1, &report, points, &context)?;
                 }
-                Err(StepError::Fatal(e)) => return Err(e),
+                Err(StepError::Fatal(e)) => {
+                    return Err(SolverError::InStep {
+                        step: summary.steps,
+                        load_factor: lambda,
+                        target,
+                        source: Box::new(e),
+                    });
+                }
                 Err(StepError::Retry {
                     cause,
                     last_residual,

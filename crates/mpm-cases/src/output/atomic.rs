@@ -89,6 +89,53 @@ fn create_temporary(dir: &Path, name: &str) -> io::Result<(PathBuf, File)> {
     Err(last_error.unwrap_or_else(|| io::Error::other("no free temporary file name")))
 }
 
+/// Removes the temporary files of writes that never finished (the process
+/// was killed or crashed between creating and renaming them) from `dir`,
+/// and returns how many there were. Only names of the form
+/// `.<name>.<pid>.<n>.tmp` that [`atomic_write`] uses are touched.
+///
+/// A run calls it when it starts, fresh or resumed, so that a directory
+/// whose run has finished holds only complete files; two runs must
+/// therefore not share an output directory.
+///
+/// # Errors
+/// [`CasesError::Io`] if `dir` cannot be read or a temporary file cannot
+/// be removed.
+pub fn remove_temporaries(dir: &Path) -> Result<usize, CasesError> {
+    let io_err = |path: PathBuf| move |source| CasesError::Io { path, source };
+    let mut removed = 0;
+    for entry in fs::read_dir(dir).map_err(io_err(dir.to_path_buf()))? {
+        let entry = entry.map_err(io_err(dir.to_path_buf()))?;
+        let temporary = entry.file_name().to_str().is_some_and(is_temporary)
+            && entry.file_type().is_ok_and(|t| t.is_file());
+        if !temporary {
+            continue;
+        }
+        match fs::remove_file(entry.path()) {
+            Ok(()) => removed += 1,
+            // Gone in between: nothing left to remove.
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+            Err(source) => return Err(io_err(entry.path())(source)),
+        }
+    }
+    Ok(removed)
+}
+
+/// Whether `file` is a name [`create_temporary`] gives:
+/// `.<name>.<pid>.<n>.tmp`.
+fn is_temporary(file: &str) -> bool {
+    let Some(inner) = file.strip_prefix('.').and_then(|s| s.strip_suffix(".tmp")) else {
+        return false;
+    };
+    let mut parts = inner.rsplitn(3, '.');
+    let mut number = || {
+        parts
+            .next()
+            .is_some_and(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
+    };
+    number() && number() && parts.next().is_some_and(|name| !name.is_empty())
+}
+
 /// Runs `write` on a buffered writer to `file`, then flushes and syncs it.
 fn write_and_sync<F>(file: File, write: F) -> io::Result<()>
 where

@@ -15,7 +15,7 @@ pub mod summary;
 mod text;
 pub mod vtk;
 
-pub use atomic::{atomic_write, atomic_write_with};
+pub use atomic::{atomic_write, atomic_write_with, remove_temporaries};
 pub use csv::{CsvTable, CsvValue};
 pub use mesh_cells::CellMesh;
 pub use pvd::{PvdSeries, PvdStep};
