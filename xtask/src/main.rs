@@ -99,7 +99,7 @@ tasks:
                 colliding disks) over every variant that applies: error and wall time
                 per refinement level, error-against-time PNG per case, the fastest run
                 reaching each error level, observed convergence orders; writes
-                docs/src/reproduction/report.md and img/report-*.png (about 15 min).
+                docs/src/reproduction/report.md and img/report-*.png (about 8 min).
                 --quick  coarse levels and a few variants per case (about a minute)
   column-table  error and run time of the column case, written to
                 docs/src/benchmarks/column.md
