@@ -69,7 +69,8 @@ pub fn read_msh<const D: usize>(path: impl AsRef<Path>) -> Result<GmshMesh<D>, M
 /// [`MeshError::UnsupportedDimension`] unless `D` is 2 or 3; with the line
 /// where it happened: [`MeshError::GmshFormat`] (no `$MeshFormat` first,
 /// version other than 4.1), [`MeshError::GmshBinary`],
-/// [`MeshError::GmshSyntax`] (a malformed or missing number or header),
+/// [`MeshError::GmshSyntax`] (a malformed or missing number or header, a
+/// NaN or infinite coordinate),
 /// [`MeshError::GmshTruncated`], [`MeshError::GmshCount`] (a declared count
 /// that the data contradicts), [`MeshError::GmshMissingSection`],
 /// [`MeshError::GmshDuplicateNode`], [`MeshError::GmshUnknownNode`],
@@ -476,6 +477,9 @@ fn read_nodes<const D: usize>(lines: &mut Lines<'_>, file: &mut File<D>) -> Resu
             ];
             if parametric == 0 && tokens.remaining() != 0 {
                 return Err(syntax(line, "node coordinates x y z", text));
+            }
+            if xyz.iter().any(|c| !c.is_finite()) {
+                return Err(syntax(line, "finite node coordinates x y z", text));
             }
             if D == 2 && xyz[2] != 0.0 {
                 return Err(MeshError::GmshNotPlanar { line, z: xyz[2] });

@@ -21,6 +21,50 @@ pub(crate) struct Buckets<const D: usize> {
     elements: Vec<u32>,
 }
 
+/// Buckets per axis for a box of edges `extent` holding `element_count`
+/// elements: about one bucket per element, of equal edge along every axis
+/// longer than that edge. An axis no longer than the edge (a thin slab, a
+/// mesh flattened along one axis) gets one bucket and the other axes share
+/// the count, so the grid has at most $2^D$ buckets per element however
+/// anisotropic the box; giving the thin axis one bucket but keeping the
+/// edge of the whole volume would make the others $1/\text{thickness}$
+/// times too fine (a mesh 1e-10 thick asked for 63 GB).
+fn bucket_counts<const D: usize>(extent: &SVector<f64, D>, element_count: usize) -> [usize; D] {
+    let n = element_count.max(1);
+    let mut thick = [true; D];
+    let mut edge = f64::INFINITY;
+    // Each pass drops the axes no longer than the edge; the edge of the
+    // remaining ones only grows, so a dropped axis stays dropped.
+    for _ in 0..D {
+        let axes = thick.iter().filter(|&&t| t).count();
+        if axes == 0 {
+            break;
+        }
+        // (volume / n)^(1 / axes), in logarithms: no underflow to 0 for
+        // tiny extents.
+        let log_volume: f64 = (0..D).filter(|&a| thick[a]).map(|a| extent[a].ln()).sum();
+        edge = ((log_volume - (n as f64).ln()) / axes as f64).exp();
+        let mut dropped = false;
+        for a in 0..D {
+            // A NaN or infinite extent (or edge) drops the axis too.
+            if thick[a] && !(extent[a] > edge && extent[a].is_finite()) {
+                thick[a] = false;
+                dropped = true;
+            }
+        }
+        if !dropped {
+            break;
+        }
+    }
+    std::array::from_fn(|a| {
+        if thick[a] {
+            ((extent[a] / edge).ceil() as usize).clamp(1, n)
+        } else {
+            1
+        }
+    })
+}
+
 impl<const D: usize> Buckets<D> {
     /// Buckets for the elements of `connectivity` (stride `D + 1`) over the
     /// box `[lower, upper]` of the nodes: about one bucket per element, of
@@ -35,10 +79,7 @@ impl<const D: usize> Buckets<D> {
         let element_count = connectivity.len() / stride;
         let extent = upper - lower;
         let slack = SLACK * extent.norm();
-        let volume: f64 = extent.iter().product();
-        let edge = (volume / element_count as f64).powf(1.0 / D as f64);
-        let counts: [usize; D] =
-            std::array::from_fn(|a| ((extent[a] / edge).ceil() as usize).clamp(1, element_count));
+        let counts = bucket_counts(&extent, element_count);
         let inverse_size = SVector::<f64, D>::from_fn(|a, _| counts[a] as f64 / extent[a]);
         let mut buckets = Self {
             lower,
@@ -122,5 +163,35 @@ impl<const D: usize> Buckets<D> {
         }
         let id = self.flat(&self.index(x));
         &self.elements[self.offsets[id]..self.offsets[id + 1]]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn about_one_bucket_per_element_however_thin_the_box() {
+        // A cube: the edge of the whole volume along every axis.
+        assert_eq!(
+            bucket_counts(&SVector::from([1.0, 1.0, 1.0]), 1000),
+            [10, 10, 10]
+        );
+        // Flattened along x by 1e-10, 1e-3, or to nothing: x gets one
+        // bucket and y, z share the 1000 (before the fix: 1000 × 1000).
+        for thickness in [1e-10, 1e-3, 0.0] {
+            let counts = bucket_counts(&SVector::from([thickness, 1.0, 1.0]), 1000);
+            assert_eq!(counts, [1, 32, 32], "{thickness}");
+        }
+        // A needle: all of them along its axis.
+        assert_eq!(
+            bucket_counts(&SVector::from([1e-9, 1.0, 1e-9]), 50),
+            [1, 50, 1]
+        );
+        // Non-finite extents never ask for more buckets than elements.
+        for bad in [f64::INFINITY, f64::NAN] {
+            let counts = bucket_counts(&SVector::from([bad, 1.0]), 100);
+            assert!(counts.iter().product::<usize>() <= 4 * 100, "{counts:?}");
+        }
     }
 }
