@@ -643,8 +643,8 @@ fn malformed_scenes_are_refused_with_a_located_message() {
         ),
         (
             "[[body]]",
-            "[[material]]\nname = \"m2\"\nmodel = \"hencky\"\nyoungs_modulus = 2e6\npoisson_ratio = 0.3\ndensity = 1.0\n\n[[body]]",
-            "bad.toml:14:8: material `m2` differs from `m` in its model or parameters: an explicit scene runs one law for now (its materials may differ in density only)",
+            "[[material]]\nname = \"m2\"\nmodel = \"neo_hookean\"\nyoungs_modulus = 2e6\npoisson_ratio = 0.3\ndensity = 1.0\n\n[[body]]",
+            "bad.toml:14:8: material `m2` is neo_hookean but `m` is hencky: the materials of one scene share one model",
         ),
         (
             "material = \"m\"",
@@ -1543,4 +1543,80 @@ set = "y_max"
         message.contains("material `h` is hencky but `m` is neo_hookean"),
         "{message}"
     );
+}
+
+/// A Gmsh mesh with a sliver or with two nodes at one position builds
+/// (both are valid meshes) with a warning that names the element or the
+/// nodes; the clean mesh builds without one.
+#[test]
+fn slivers_and_coincident_nodes_in_a_gmsh_mesh_are_warned_about() {
+    let msh = |nodes: &[[f64; 2]], triangles: &[[usize; 3]]| {
+        let n = nodes.len();
+        let mut s =
+            format!("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 {n} 1 {n}\n2 1 0 {n}\n");
+        for i in 1..=n {
+            s += &format!("{i}\n");
+        }
+        for x in nodes {
+            s += &format!("{} {} 0\n", x[0], x[1]);
+        }
+        let m = triangles.len();
+        s += &format!("$EndNodes\n$Elements\n1 {m} 1 {m}\n2 1 2 {m}\n");
+        for (i, t) in triangles.iter().enumerate() {
+            s += &format!("{} {} {} {}\n", i + 1, t[0], t[1], t[2]);
+        }
+        s + "$EndElements\n"
+    };
+    let square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let cases = [
+        ("clean", msh(&square, &[[1, 2, 3], [1, 3, 4]]), None),
+        (
+            "sliver",
+            msh(
+                &[
+                    square[0],
+                    square[1],
+                    square[2],
+                    square[3],
+                    [0.5, 1.0 + 1e-5],
+                ],
+                &[[1, 2, 3], [1, 3, 4], [4, 3, 5]],
+            ),
+            Some("1 element(s) are slivers"),
+        ),
+        (
+            "coincident",
+            msh(
+                &[square[0], square[1], square[2], square[3], square[2]],
+                &[[1, 2, 3], [1, 5, 4]],
+            ),
+            Some("nodes 2 and 4 share a position"),
+        ),
+    ];
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("mesh_warnings");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, text, expected) in cases {
+        std::fs::write(dir.join(format!("{name}.msh")), text).unwrap();
+        let scene_text = format!(
+            "[mesh]\nkind = \"gmsh\"\nfile = \"{name}.msh\"\ndimension = 2\n\n\
+             [[material]]\nname = \"m\"\nmodel = \"hencky\"\nyoungs_modulus = 1e6\npoisson_ratio = 0.3\ndensity = 1.0\n\n\
+             [[body]]\nname = \"b\"\nmaterial = \"m\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [1.0, 1.0] }} }}\n\n\
+             [[boundary]]\nset = \"y_min\"\nkind = \"fixed\"\n"
+        );
+        let (scene, src) = scene::parse(&scene_text, "w.toml", &[]).unwrap();
+        let problem =
+            Problem::<2>::build_in(&scene, &src, 0, &dir).unwrap_or_else(|e| panic!("{name}: {e}"));
+        match expected {
+            None => assert!(
+                problem.warnings.is_empty(),
+                "{name}: {:?}",
+                problem.warnings
+            ),
+            Some(text) => {
+                assert_eq!(problem.warnings.len(), 1, "{name}: {:?}", problem.warnings);
+                let w = &problem.warnings[0];
+                assert!(w.starts_with("[mesh]: ") && w.contains(text), "{name}: {w}");
+            }
+        }
+    }
 }

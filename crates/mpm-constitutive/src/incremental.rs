@@ -27,6 +27,7 @@ use nalgebra::Matrix3;
 use crate::driver::{self, MaterialState};
 use crate::error::{ConstitutiveError, Result};
 use crate::law::LogStrainLaw;
+use crate::material_set::{MaterialSet, Tagged};
 use crate::neo_hookean::NeoHookean;
 use crate::spectral::SymSpectral;
 
@@ -54,6 +55,47 @@ pub trait IncrementalLaw: Send + Sync {
     /// $c = \sqrt{(K + \tfrac43 G)/\rho}$ (MPoint notes eq. 46, with
     /// $K = E/(3(1-2\nu))$: the notes' $E/(3(1+\nu))$ is a misprint).
     fn p_wave_modulus(&self) -> f64;
+
+    /// The P-wave modulus of the point whose state is `state`: the law's
+    /// own [`Self::p_wave_modulus`] unless the law holds several materials
+    /// ([`MaterialSet`]), whose points each have their material's. The
+    /// time step of eq. (45) takes $\max_p(c_p + \|v_p\|)$ with
+    /// $c_p = \sqrt{M_p/\rho_p}$ from it, so a stiff layer sets the step
+    /// where it is, not a soft layer's points at the stiff modulus.
+    #[inline(always)]
+    fn point_p_wave_modulus(&self, state: &Self::State) -> f64 {
+        let _ = state;
+        self.p_wave_modulus()
+    }
+}
+
+/// Several materials in one explicit analysis: the update, the stored
+/// energy and the wave modulus of each point's material (its [`Tagged`]
+/// state). [`IncrementalLaw::p_wave_modulus`] of the set is the largest of
+/// its materials' (an upper bound); the step uses each point's own.
+impl<L: IncrementalLaw> IncrementalLaw for MaterialSet<L> {
+    type State = Tagged<L::State>;
+
+    #[inline]
+    fn update(&self, delta_f: &Matrix3<f64>, state: &mut Self::State) -> Result<Matrix3<f64>> {
+        self.law(state.material).update(delta_f, &mut state.inner)
+    }
+
+    fn stored_energy(&self, state: &Self::State) -> Result<f64> {
+        self.law(state.material).stored_energy(&state.inner)
+    }
+
+    fn p_wave_modulus(&self) -> f64 {
+        self.laws()
+            .iter()
+            .map(IncrementalLaw::p_wave_modulus)
+            .fold(0.0, f64::max)
+    }
+
+    #[inline(always)]
+    fn point_p_wave_modulus(&self, state: &Self::State) -> f64 {
+        self.law(state.material).p_wave_modulus()
+    }
 }
 
 /// Any [`LogStrainLaw`] as an [`IncrementalLaw`], through the finite-strain

@@ -83,7 +83,7 @@ impl<L> MaterialSet<L> {
     /// points and checked with [`Self::contains`] where they come from
     /// outside; an index past the end is a bug of the caller.
     #[inline]
-    fn law(&self, material: u32) -> &L {
+    pub(crate) fn law(&self, material: u32) -> &L {
         &self.laws[material as usize]
     }
 }

@@ -1,12 +1,14 @@
 //! The incremental (explicit-solver) stress updates: the closed-form
 //! Neo-Hookean update against the spectral driver, objectivity and the
 //! absence of rate-form drift, the stored energy as the potential of the
-//! stress, the wave modulus with the corrected bulk modulus.
+//! stress, the wave modulus with the corrected bulk modulus, a set of
+//! materials answering as each of its laws.
 #![allow(clippy::unwrap_used)]
 
 use mpm_constitutive::verification::strategies::{config, deformation_gradient, rotation};
 use mpm_constitutive::{
-    ConstitutiveError, HenckyElastic, IncrementalLaw, MaterialState, NeoHookean, Spectral, VonMises,
+    ConstitutiveError, HenckyElastic, IncrementalLaw, MaterialSet, MaterialState, NeoHookean,
+    Spectral, Tagged, VonMises,
 };
 use nalgebra::Matrix3;
 use proptest::prelude::*;
@@ -195,4 +197,43 @@ fn wave_modulus_uses_the_correct_bulk_modulus() {
         Spectral::with_p_wave_modulus(neo, -1.0),
         Err(ConstitutiveError::InvalidWaveModulus { .. })
     ));
+}
+
+/// A set of materials updates, stores energy and reports the wave modulus
+/// of each point's own material, bit for bit as that law alone; the set's
+/// modulus is the largest.
+#[test]
+fn a_material_set_answers_as_each_points_law() {
+    let laws = vec![
+        NeoHookean::new(1e5, 0.3).unwrap(),
+        NeoHookean::new(1e11, 0.2).unwrap(),
+        NeoHookean::new(3e7, 0.45).unwrap(),
+    ];
+    let set = MaterialSet::new(laws.clone()).unwrap();
+    let df = Matrix3::new(1.02, 0.01, 0.0, -0.005, 0.97, 0.003, 0.0, 0.002, 1.01);
+    for (k, law) in laws.iter().enumerate() {
+        let mut alone = MaterialState::<()>::default();
+        let mut tagged = Tagged::new(k as u32, MaterialState::<()>::default());
+        for _ in 0..3 {
+            let want = law.update(&df, &mut alone).unwrap();
+            let got = set.update(&df, &mut tagged).unwrap();
+            assert_eq!(got, want, "material {k}");
+        }
+        assert_eq!(tagged.material, k as u32);
+        assert_eq!(tagged.inner, alone);
+        assert_eq!(
+            set.stored_energy(&tagged).unwrap(),
+            law.stored_energy(&alone).unwrap()
+        );
+        assert_eq!(set.point_p_wave_modulus(&tagged), law.p_wave_modulus());
+        // A law of one material reports its own modulus for every point.
+        assert_eq!(law.point_p_wave_modulus(&alone), law.p_wave_modulus());
+    }
+    assert_eq!(set.p_wave_modulus(), laws[1].p_wave_modulus());
+    // An inverting increment is refused and leaves the tagged state.
+    let mut tagged = Tagged::new(2, MaterialState::<()>::default());
+    let before = tagged;
+    let flip = Matrix3::from_diagonal(&nalgebra::Vector3::new(-1.0, 1.0, 1.0));
+    assert!(set.update(&flip, &mut tagged).is_err());
+    assert_eq!(tagged, before);
 }

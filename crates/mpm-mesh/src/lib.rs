@@ -63,6 +63,6 @@ pub use random::SplitMix64;
 pub use regular_grid::{CellLocation, CellNodes, Face, RegularGrid, Side};
 pub use sets::{MeshSets, NamedSets};
 pub use simplex::{
-    BARYCENTRIC_TOLERANCE, BoundaryFace, Location, NO_NEIGHBOUR, SimplexMesh, Walk,
-    quadratic_node_count,
+    BARYCENTRIC_TOLERANCE, BoundaryFace, COINCIDENT_TOLERANCE, Location, MeshQuality, NO_NEIGHBOUR,
+    SLIVER_SHAPE, SimplexMesh, Walk, quadratic_node_count, shape_measure,
 };

@@ -655,3 +655,142 @@ fn tensor_kernels_match_the_node_by_node_path() {
         );
     }
 }
+
+/// A very soft and a very stiff body (E = 10³ and 10⁹ Pa, ϱ = 1 and
+/// 1000 kg/m³) far apart on one grid, run as a `MaterialSet`: each moves
+/// as it does alone with its own law and the same Δt, and the CFL step is
+/// the stiff body's alone. Giving every point the set's largest modulus
+/// would make the soft points (ϱ = 1) 31.6× faster than the stiff ones
+/// and the step 31.6× shorter.
+#[test]
+fn a_soft_and_a_stiff_body_step_with_their_own_wave_speeds() {
+    use mpm_constitutive::{IncrementalLaw, MaterialSet, Tagged};
+    type Set = MaterialSet<NeoHookean>;
+    let grid = || RegularGrid::new(Vector2::zeros(), Vector2::new(0.1, 0.1), [30, 12]).unwrap();
+    let soft = NeoHookean::new(1e3, 0.3).unwrap();
+    let stiff = NeoHookean::new(1e9, 0.3).unwrap();
+    // Spinning and stretching: both bodies deform and stress.
+    let motion = |c: Vector2<f64>| {
+        move |x: &Vector2<f64>| Vector2::new(-(x.y - c.y) + 0.3 * (x.x - c.x), x.x - c.x) * 0.5
+    };
+    let (lo_a, hi_a) = (Vector2::new(0.4, 0.4), Vector2::new(1.0, 0.8));
+    let (lo_b, hi_b) = (Vector2::new(2.0, 0.4), Vector2::new(2.6, 0.8));
+    let (c_a, c_b) = ((lo_a + hi_a) / 2.0, (lo_b + hi_b) / 2.0);
+    let run_alone = |law: NeoHookean, lo, hi, density, c, dt: Option<f64>| {
+        let (x0, vol) = block(lo, hi, 0.1, 2);
+        let mut points: PointsFor<2, NeoHookean, Flip> =
+            ExplicitPoints::new(x0, vol, density).unwrap();
+        points.set_velocity(motion(c));
+        let time_step = dt.map_or(TimeStep::Cfl { factor: 0.5 }, TimeStep::Fixed);
+        let options = ExplicitOptions {
+            time_step,
+            ..Default::default()
+        };
+        let mut solver = ExplicitSolver::new(
+            QuadraticBSpline,
+            grid(),
+            law,
+            Flip,
+            NoLocking,
+            VelocityFixities::new(),
+            options,
+        )
+        .unwrap();
+        let stable = solver.stable_increment(&points);
+        if dt.is_some() {
+            solver
+                .run_until(&mut points, 0.05, |_, _, _| Ok(()))
+                .unwrap();
+        }
+        (points, stable)
+    };
+    let (_, stiff_limit) = run_alone(stiff, lo_b, hi_b, 1000.0, c_b, None);
+    let (_, soft_limit) = run_alone(soft, lo_a, hi_a, 1.0, c_a, None);
+    assert!(
+        soft_limit > 30.0 * stiff_limit,
+        "{soft_limit} vs {stiff_limit}"
+    );
+    let dt = 0.5 * stiff_limit;
+
+    // Both bodies in one run: body A soft (material 0), body B stiff (1).
+    let (xa, va) = block(lo_a, hi_a, 0.1, 2);
+    let (xb, vb) = block(lo_b, hi_b, 0.1, 2);
+    let na = xa.len();
+    let x0: Vec<_> = xa.into_iter().chain(xb).collect();
+    let vol: Vec<_> = va.into_iter().chain(vb).collect();
+    let mut points: PointsFor<2, Set, Flip> = ExplicitPoints::new(x0, vol, 1.0).unwrap();
+    for p in na..points.len() {
+        points.mass[p] *= 1000.0;
+        points.material[p] = Tagged::new(1, Default::default());
+    }
+    let (ma, mb) = (motion(c_a), motion(c_b));
+    points.set_velocity(|x| if x.x < 1.5 { ma(x) } else { mb(x) });
+    let set = MaterialSet::new(vec![soft, stiff]).unwrap();
+    assert_eq!(set.p_wave_modulus(), stiff.p_wave_modulus());
+    let mut solver = ExplicitSolver::new(
+        QuadraticBSpline,
+        grid(),
+        set,
+        Flip,
+        NoLocking,
+        VelocityFixities::new(),
+        ExplicitOptions {
+            time_step: TimeStep::Cfl { factor: 0.5 },
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let together = solver.stable_increment(&points);
+    assert!(
+        (together / stiff_limit - 1.0).abs() < 1e-12,
+        "the set's step {together} against the stiff body's {stiff_limit}"
+    );
+    let mut fixed = ExplicitSolver::new(
+        QuadraticBSpline,
+        grid(),
+        solver.law().clone(),
+        Flip,
+        NoLocking,
+        VelocityFixities::new(),
+        ExplicitOptions {
+            time_step: TimeStep::Fixed(dt),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let steps = fixed
+        .run_until(&mut points, 0.05, |_, _, _| Ok(()))
+        .unwrap();
+    assert!(steps > 500, "{steps} steps");
+
+    let (a, _) = run_alone(soft, lo_a, hi_a, 1.0, c_a, Some(dt));
+    let (b, _) = run_alone(stiff, lo_b, hi_b, 1000.0, c_b, Some(dt));
+    // Differences: positions in metres, velocities relative to the body's
+    // largest, stresses relative to the body's P-wave modulus (a strain:
+    // the rounding of sums split differently among the threads' chunks
+    // moves the points by 1e-15 m, which the stiff body turns into
+    // stresses 1e-9 of its own).
+    let scale = |body: &PointsFor<2, NeoHookean, Flip>, law: &NeoHookean| {
+        let v = body.velocity.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        (law.p_wave_modulus(), v)
+    };
+    let (scale_a, scale_b) = (scale(&a, &soft), scale(&b, &stiff));
+    let mut worst = [0.0f64; 3];
+    for (p, q) in (0..na)
+        .map(|p| (p, p))
+        .chain((0..b.len()).map(|q| (na + q, q)))
+    {
+        let (alone, (tau, v)) = if p < na { (&a, scale_a) } else { (&b, scale_b) };
+        worst[0] = worst[0].max((points.position[p] - alone.position[q]).norm());
+        worst[1] = worst[1].max((points.velocity[p] - alone.velocity[q]).norm() / v);
+        worst[2] = worst[2].max((points.tau[p] - alone.tau[q]).norm() / tau);
+        assert_eq!(points.material[p].material, u32::from(p >= na));
+    }
+    assert!(
+        worst.iter().all(|&w| w < 1e-10),
+        "the set's bodies differ from their runs alone by (position, velocity, stress) {worst:?}"
+    );
+    // Both bodies deformed: the soft one stretched, the stiff one stressed.
+    assert!(a.tau.iter().any(|t| t.norm() > 1.0));
+    assert!(b.tau.iter().any(|t| t.norm() > 1e3));
+}

@@ -18,7 +18,7 @@ use crate::CasesError;
 use crate::material::{LawVisitor, MaterialModel, MaterialParams, dispatch_law};
 use crate::run::HistoryOutput;
 use crate::scene_file::SceneSource;
-use crate::variant::{BasisKind, LockingKind, Variant};
+use crate::variant::{BasisKind, DomainUpdateKind, LockingKind, Variant};
 
 use super::format::{
     BoundaryKind, Field, LinearKind, LoadKind, MeshKind, MotionKind, Placement, RegionSpec, Scene,
@@ -26,8 +26,8 @@ use super::format::{
 };
 use super::region::{Region, point};
 
-/// Largest number of grid nodes or material points a scene may ask for
-/// (a guard against a typo allocating the machine's memory).
+/// Largest number of grid nodes, simplices or material points a scene may
+/// ask for (a guard against a typo allocating the machine's memory).
 pub const MAX_ENTITIES: usize = 50_000_000;
 
 const AXES: [&str; 3] = ["x", "y", "z"];
@@ -351,6 +351,11 @@ pub struct Problem<const D: usize> {
     /// "explicit"` (run it with [`super::run_explicit`]); `None` for the
     /// implicit solver.
     pub explicit: Option<ExplicitSetup<D>>,
+    /// What the scene may not mean but is allowed: a simplex mesh's
+    /// slivers and coincident nodes ([`mpm_mesh::MeshQuality::warnings`]),
+    /// each prefixed by where it comes from. `mpm run` prints them and
+    /// writes them into `summary.json`.
+    pub warnings: Vec<String>,
 }
 
 /// A reaction history of `[[output.reaction]]`: the sum of the reactions
@@ -544,6 +549,26 @@ impl<const D: usize> Problem<D> {
             domain_update: *solver.domain_update.get_ref(),
             gimp_volume: *solver.gimp_volume.get_ref(),
         };
+        // The pairs the variant dispatch accepts, refused here at the key
+        // rather than when the run starts.
+        let (update, basis) = (variant.domain_update, variant.basis);
+        let misfit = match (basis, update) {
+            (_, DomainUpdateKind::None) | (BasisKind::Cpdi2, DomainUpdateKind::Cpdi2) => None,
+            (BasisKind::Gimp, DomainUpdateKind::Cpdi2) => Some(
+                "domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2"
+                    .to_owned(),
+            ),
+            (BasisKind::Gimp, _) => None,
+            (BasisKind::Cpdi2, other) => Some(format!(
+                "basis = cpdi2 convects its corners with the grid; domain_update = {other} applies to gimp only"
+            )),
+            (other, _) => Some(format!(
+                "domain_update = {update} needs basis = gimp ({other} has no domain to update)"
+            )),
+        };
+        if let Some(message) = misfit {
+            return Err(src.at(&solver.domain_update, message));
+        }
         let basis_padding = basis_padding.max(solver.padding());
 
         // Mesh.
@@ -772,6 +797,20 @@ impl<const D: usize> Problem<D> {
                         (origin_v, upper, cells, Some(lines))
                     }
                 };
+                // D! simplices per cell, each split into 2^D children with
+                // patches: bounded as the nodes are, before any is built.
+                let per_cell = (1..=D).product::<usize>() << if patches { D } else { 0 };
+                let elements = cells.iter().try_fold(per_cell, |n, &c| n.checked_mul(c));
+                if elements.is_none_or(|n| n > MAX_ENTITIES) {
+                    let at = (m.cells.as_ref().map(Spanned::span))
+                        .or_else(|| m.spacing.as_ref().map(Spanned::span))
+                        .or_else(|| m.coordinates.as_ref().map(Spanned::span))
+                        .unwrap_or_else(|| size.span());
+                    return Err(src.error(
+                        Some(at),
+                        &format!("the mesh would have more than {MAX_ENTITIES} elements"),
+                    ));
+                }
                 let boxed = mpm_mesh::BoxMesh::new(origin_v, upper, cells);
                 let mut simplices = if patches {
                     boxed
@@ -797,6 +836,12 @@ impl<const D: usize> Problem<D> {
                 }
                 (SceneMesh::Simplex(Box::new(simplices)), origin_v, upper, 0)
             }
+        };
+        let warnings: Vec<String> = match &mesh {
+            SceneMesh::Simplex(sm) => (sm.quality().warnings().into_iter())
+                .map(|w| format!("[mesh]: {w}"))
+                .collect(),
+            SceneMesh::Grid(_) => Vec::new(),
         };
         let size = upper - origin;
         let tol = 1e-9 * size.max();
@@ -861,23 +906,6 @@ impl<const D: usize> Problem<D> {
                 yield_stress: spec.yield_stress,
                 hardening: spec.hardening,
             };
-            if explicit
-                && let Some(first) = scene.materials.first()
-                && (first.model != spec.model
-                    || first.youngs_modulus != spec.youngs_modulus
-                    || first.poisson_ratio != spec.poisson_ratio
-                    || first.yield_stress != spec.yield_stress
-                    || first.hardening != spec.hardening)
-            {
-                return Err(src.at(
-                    &spec.name,
-                    format!(
-                        "material `{}` differs from `{}` in its model or parameters: an explicit scene runs one law for now (its materials may differ in density only)",
-                        spec.name.get_ref(),
-                        first.name.get_ref()
-                    ),
-                ));
-            }
             if spec.model != MaterialModel::VonMises && spec.yield_stress.is_some() {
                 return Err(src.at(
                     &spec.name,
@@ -1843,14 +1871,17 @@ impl<const D: usize> Problem<D> {
         }
         let safe = |name: &Spanned<String>| -> Result<String, CasesError> {
             let v = name.get_ref();
+            // 200 bytes leave room for the suffixes within the 255 of a
+            // file name on common file systems.
             if v.is_empty()
+                || v.len() > 200
                 || !v
                     .chars()
                     .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
             {
                 return Err(src.at(
                     name,
-                    "an output name must be letters, digits, `_` or `-` (it names a file)",
+                    "an output name must be 1 to 200 letters, digits, `_` or `-` (it names a file)",
                 ));
             }
             Ok(v.clone())
@@ -1885,6 +1916,33 @@ impl<const D: usize> Problem<D> {
             return Err(src.error(None, "output `png` draws 2D scenes only"));
         }
         let fields = o.fields.clone().unwrap_or_else(|| Field::ALL.to_vec());
+        // A CFL step is h / max(c + |v|) over the initial points (the
+        // solver computes the signal speed once): the fixed `time_step`'s
+        // bound of 1e9 steps, applied before running.
+        if let (Some(k), SceneMesh::Grid(grid)) = (&explicit_keys, &mesh)
+            && let mpm_solver::TimeStep::Cfl { factor } = k.time_step
+        {
+            let wave = |m: &BuiltMaterial| {
+                let (e, nu) = (m.params.youngs_modulus, m.params.poisson_ratio);
+                (e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)) / m.density).sqrt()
+            };
+            let c = materials.iter().map(wave).fold(0.0, f64::max);
+            let v = initial_velocity
+                .iter()
+                .map(|v| v.norm())
+                .fold(0.0, f64::max);
+            let steps = k.end_time * (c + v) / (factor * grid.spacing().min());
+            if steps.is_nan() || steps > 1e9 {
+                let at = solver
+                    .cfl
+                    .as_ref()
+                    .map_or(solver.kind.span(), Spanned::span);
+                return Err(src.error(
+                    Some(at),
+                    &format!("solver `cfl` {factor:e} would take {steps:.1e} steps of h / max(c + |v|) to reach end_time {}; more than 1e9", k.end_time),
+                ));
+            }
+        }
         let explicit = explicit_keys.map(|k| {
             // One call per component and value (each call sorts the list).
             let mut groups: BTreeMap<(usize, u64), Vec<usize>> = BTreeMap::new();
@@ -1915,6 +1973,7 @@ impl<const D: usize> Problem<D> {
         });
 
         Ok(Self {
+            warnings,
             mesh,
             padding,
             bodies,

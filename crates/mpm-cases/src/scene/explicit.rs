@@ -7,9 +7,12 @@
 //!
 //! The solvers are compiled once per dimension, here ([`RunExplicit`]):
 //! basis (`linear`, `bspline2`) × law (closed-form `NeoHookean`,
-//! `Spectral<HenckyElastic>`, `Spectral<VonMises>`) × transfer
-//! (`FlipPic`, which covers PIC, FLIP and their blend; `Taylor`) ×
-//! dilatation (`NoLocking`, `CellAveraged`): 24 solvers per dimension.
+//! `Spectral<HenckyElastic>`, `Spectral<VonMises>`, each alone or as a
+//! `MaterialSet` when the scene's materials differ in more than density)
+//! × transfer (`FlipPic`, which covers PIC, FLIP and their blend;
+//! `Taylor`) × dilatation (`NoLocking`, `CellAveraged`): 48 solvers per
+//! dimension. A scene of one material (or of materials that differ in
+//! density only) runs the law alone: no tag per point, one wave modulus.
 //!
 //! ```
 //! use mpm_cases::run::RunControl;
@@ -58,7 +61,8 @@ use std::time::Instant;
 
 use mpm_basis::{BasisFunction, LinearMpm, QuadraticBSpline};
 use mpm_constitutive::{
-    HenckyElastic, IncrementalLaw, MaterialState, NeoHookean, Spectral, VonMises,
+    HenckyElastic, IncrementalLaw, MaterialSet, MaterialState, NeoHookean, Spectral, Tagged,
+    VonMises,
 };
 use mpm_mesh::RegularGrid;
 use mpm_solver::explicit::{
@@ -235,7 +239,8 @@ struct Run<'a, 'o, const D: usize> {
 }
 
 impl<const D: usize> Run<'_, '_, D> {
-    /// The law (one material per explicit scene).
+    /// The law: one, or a [`MaterialSet`] when the materials differ in
+    /// more than their density.
     fn with_basis<B>(self, basis: B) -> Result<ExplicitOutput, SolverError>
     where
         B: BasisFunction<D, Domain = (), Mesh = RegularGrid<D>>,
@@ -245,22 +250,46 @@ impl<const D: usize> Run<'_, '_, D> {
                 "the scene has no material".into(),
             ));
         };
-        let p = &material.params;
-        let (e, nu) = (p.youngs_modulus, p.poisson_ratio);
+        // Materials that differ in density only share one law (no tag per
+        // point); others make a set, each point tagged with its material.
+        let materials = &self.problem.materials;
+        let one_law = materials.iter().all(|m| m.params == material.params);
+        macro_rules! with_laws {
+            (|$p:ident| $make:expr) => {{
+                if one_law {
+                    let $p = &material.params;
+                    self.with_law(basis, $make)
+                } else {
+                    let laws = materials
+                        .iter()
+                        .map(|m| -> Result<_, SolverError> {
+                            let $p = &m.params;
+                            Ok($make)
+                        })
+                        .collect::<Result<Vec<_>, _>>()?;
+                    self.with_law(basis, MaterialSet::new(laws)?)
+                }
+            }};
+        }
         match material.model {
-            MaterialModel::NeoHookean => self.with_law(basis, NeoHookean::new(e, nu)?),
-            MaterialModel::Hencky => {
-                self.with_law(basis, Spectral::new(HenckyElastic::new(e, nu)?)?)
+            MaterialModel::NeoHookean => {
+                with_laws!(|p| NeoHookean::new(p.youngs_modulus, p.poisson_ratio)?)
             }
-            MaterialModel::VonMises => {
+            MaterialModel::Hencky => with_laws!(|p| Spectral::new(HenckyElastic::new(
+                p.youngs_modulus,
+                p.poisson_ratio
+            )?)?),
+            MaterialModel::VonMises => with_laws!(|p| {
                 let yield_stress = p.yield_stress.ok_or_else(|| {
                     SolverError::InvalidInput("material = von_mises needs yield_stress".into())
                 })?;
-                self.with_law(
-                    basis,
-                    Spectral::new(VonMises::new(e, nu, yield_stress, p.hardening)?)?,
-                )
-            }
+                Spectral::new(VonMises::new(
+                    p.youngs_modulus,
+                    p.poisson_ratio,
+                    yield_stress,
+                    p.hardening,
+                )?)?
+            }),
         }
     }
 
@@ -343,6 +372,9 @@ impl<const D: usize> Run<'_, '_, D> {
         points.mass.clone_from(&problem.mass);
         points.velocity.clone_from(&setup.velocity);
         points.point_force.clone_from(&setup.point_forces);
+        for (state, &m) in points.material.iter_mut().zip(&problem.material_of_point) {
+            *state = L::State::for_material(m);
+        }
         if points.mass.len() != points.len() || points.velocity.len() != points.len() {
             return Err(SolverError::InvalidInput(format!(
                 "{} points but {} masses and {} velocities",
@@ -367,7 +399,20 @@ impl<const D: usize> Run<'_, '_, D> {
         let mut clock = match &self.control.resume {
             Some(c) => {
                 let clock = Clock::from_checkpoint(c)?;
+                let scene_tags: Vec<u32> =
+                    points.material.iter().map(FlatState::material).collect();
                 points = read_points::<D, L::State, T::PointState>(&c.points, points)?;
+                // A tag past the set's end would index no law: the
+                // checkpoint must be of this scene's materials.
+                if let Some(p) =
+                    (0..points.len()).find(|&p| points.material[p].material() != scene_tags[p])
+                {
+                    return Err(SolverError::InvalidInput(format!(
+                        "the checkpoint gives point {p} material {}, the scene material {}",
+                        points.material[p].material(),
+                        scene_tags[p]
+                    )));
+                }
                 solver.resume_at(
                     c.state.load_factor,
                     c.state.summary.steps,
@@ -629,6 +674,45 @@ pub trait FlatState: Copy + Default + Send + Sync + std::fmt::Debug + PartialEq 
     /// Equivalent plastic strain of a law's state (0 otherwise).
     fn plastic_strain(&self) -> f64 {
         0.0
+    }
+    /// The initial state of a point of scene material `material`: tagged
+    /// with it for a [`MaterialSet`]'s state, the default otherwise.
+    fn for_material(material: u32) -> Self {
+        let _ = material;
+        Self::default()
+    }
+    /// The material a state is tagged with (0 when untagged).
+    fn material(&self) -> u32 {
+        0
+    }
+}
+
+/// A [`MaterialSet`]'s state: the material index, then the law's state.
+impl<S: FlatState> FlatState for Tagged<S> {
+    const LEN: usize = 1 + S::LEN;
+    fn write(&self, out: &mut Vec<f64>) {
+        out.push(f64::from(self.material));
+        self.inner.write(out);
+    }
+    fn read(from: &[f64]) -> Self {
+        // Anything but a whole number in range reads as u32::MAX, which
+        // the caller's check against the scene's tags refuses.
+        let m = from[0];
+        let material = if m.fract() == 0.0 && (0.0..f64::from(u32::MAX)).contains(&m) {
+            m as u32
+        } else {
+            u32::MAX
+        };
+        Self::new(material, S::read(&from[1..]))
+    }
+    fn plastic_strain(&self) -> f64 {
+        self.inner.plastic_strain()
+    }
+    fn for_material(material: u32) -> Self {
+        Self::new(material, S::default())
+    }
+    fn material(&self) -> u32 {
+        self.material
     }
 }
 

@@ -39,6 +39,9 @@ where
 
     let problem =
         Problem::<D>::build_in(scene, source, scene.solver.padding(), &session.scene_dir)?;
+    for w in &problem.warnings {
+        eprintln!("warning: {}: {w}", source.origin());
+    }
     if problem.explicit.is_some() {
         if session.export_tangent {
             return Err(source.error(
@@ -156,6 +159,9 @@ fn scene_results<const D: usize>(
 ) -> Result<Map<String, Value>, CasesError> {
     let mut results = Map::new();
     results.insert("probes".into(), Value::Object(last_probes));
+    if !problem.warnings.is_empty() {
+        results.insert("warnings".into(), json!(problem.warnings));
+    }
     results.insert(
         "bodies".into(),
         json!(

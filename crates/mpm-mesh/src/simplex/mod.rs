@@ -18,6 +18,7 @@ mod buckets;
 mod geometry;
 mod locate;
 mod neighbours;
+mod quality;
 mod reference;
 
 use nalgebra::{SMatrix, SVector};
@@ -29,6 +30,7 @@ pub(crate) use geometry::{
 };
 pub use locate::{BARYCENTRIC_TOLERANCE, Location, Walk};
 pub use neighbours::{BoundaryFace, NO_NEIGHBOUR};
+pub use quality::{COINCIDENT_TOLERANCE, MeshQuality, SLIVER_SHAPE, shape_measure};
 pub use reference::quadratic_node_count;
 pub(crate) use reference::{EDGES, edge_count, swap_orientation};
 

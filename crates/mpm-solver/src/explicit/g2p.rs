@@ -129,15 +129,14 @@ pub fn signal_speed<const D: usize>(
 
 /// The end of a point's update, shared by the fused and the averaged
 /// stage: [`deform`] with the unmodified gradient `grad` and the law's
-/// gradient `grad_bar`, the transfer state, and the point's $c_p + \|v_p\|$.
+/// gradient `grad_bar`, the transfer state, and the point's $c_p + \|v_p\|$
+/// (with its material's modulus, [`IncrementalLaw::point_p_wave_modulus`]).
 ///
 /// # Errors
 /// As [`deform`], and a non-finite velocity.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 pub fn finish<const D: usize, L: IncrementalLaw, T: super::Transfer<D>>(
     law: &L,
-    p_wave_modulus: f64,
     dt: f64,
     grad: &SMatrix<f64, D, D>,
     grad_bar: Option<&SMatrix<f64, D, D>>,
@@ -155,7 +154,8 @@ pub fn finish<const D: usize, L: IncrementalLaw, T: super::Transfer<D>>(
         point.material,
     )?;
     *point.transfer = T::next_state(grad);
-    let s = signal_speed(p_wave_modulus, point.mass, *point.volume, point.velocity);
+    let m = law.point_p_wave_modulus(point.material);
+    let s = signal_speed(m, point.mass, *point.volume, point.velocity);
     if s.is_finite() {
         Ok(s)
     } else {

@@ -290,10 +290,11 @@ where
     /// points' current state (from the last step's grid-to-point stage, or
     /// computed from the points before the first step).
     pub fn stable_increment(&mut self, points: &PointsFor<D, L, T>) -> f64 {
-        let m = self.law.p_wave_modulus();
+        let law = &self.law;
         let signal = *self.max_signal.get_or_insert_with(|| {
             (0..points.len())
                 .map(|p| {
+                    let m = law.point_p_wave_modulus(&points.material[p]);
                     g2p::signal_speed(m, points.mass[p], points.volume[p], &points.velocity[p])
                 })
                 .fold(0.0, f64::max)
@@ -521,7 +522,7 @@ where
     ) -> Result<f64, (usize, PointFailure)> {
         let per = task_size(points.len());
         let (basis, mesh, grid, law) = (&self.basis, &self.mesh, &self.grid, &self.law);
-        let (alpha, m) = (self.transfer.alpha(), law.p_wave_modulus());
+        let alpha = self.transfer.alpha();
         let p = points;
         let results: Vec<Result<f64, (usize, PointFailure)>> = (
             p.position.par_chunks_mut(per),
@@ -546,7 +547,6 @@ where
                     g2p::move_point(alpha, dt, &g, &mut x[k], &mut v[k]);
                     let s = g2p::finish::<D, L, T>(
                         law,
-                        m,
                         dt,
                         &g.grad,
                         None,
@@ -622,7 +622,6 @@ where
             }
         }
         let (law, sums, cells) = (&self.law, &self.cell_sums, &self.cell_scratch);
-        let m = law.p_wave_modulus();
         let p = points;
         let results: Vec<Result<f64, (usize, PointFailure)>> = (
             p.f.par_chunks_mut(per),
@@ -654,7 +653,6 @@ where
                         }
                         let s = g2p::finish::<D, L, T>(
                             law,
-                            m,
                             dt,
                             grad,
                             Some(&bar),
