@@ -73,7 +73,8 @@ pub enum SolverError {
     /// A load step kept failing after the increment was halved down to the
     /// minimum.
     #[error(
-        "load step {step} (load factor {load_factor} -> {target}) failed with increment {increment:e} <= minimum {min_increment:e}; last normalised residual {last_residual:e}; cause: {cause}"
+        "load step {step} (load factor {load_factor} -> {target}) failed with increment {increment:e} <= minimum {min_increment:e}; last normalised residual {}; cause: {cause}",
+        residual_text(*.last_residual)
     )]
     StepTooSmall {
         /// Index of the step (counting converged steps from 0).
@@ -86,7 +87,9 @@ pub enum SolverError {
         increment: f64,
         /// The minimum increment allowed.
         min_increment: f64,
-        /// The last normalised residual seen.
+        /// The last attempt's last normalised residual; NaN when that
+        /// attempt failed before its first residual (in the stress update
+        /// or the basis), printed as "none".
         last_residual: f64,
         /// The last failure.
         cause: StepFailure,
@@ -322,4 +325,44 @@ pub enum PointFailure {
         /// The velocity.
         velocity: Vec<f64>,
     },
+}
+
+/// A residual for a message: "none" for the NaN that stands for no
+/// residual computed yet.
+fn residual_text(residual: f64) -> String {
+    if residual.is_nan() {
+        "none (the last attempt failed before its first residual)".to_owned()
+    } else {
+        format!("{residual:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn too_small(last_residual: f64) -> String {
+        SolverError::StepTooSmall {
+            step: 3,
+            load_factor: 0.5,
+            target: 0.75,
+            increment: 1e-5,
+            min_increment: 1e-5,
+            last_residual,
+            cause: StepFailure::Diverged {
+                iteration: 2,
+                residual: 1e3,
+            },
+        }
+        .to_string()
+    }
+
+    #[test]
+    fn a_step_without_a_residual_says_so_instead_of_nan() {
+        let none = too_small(f64::NAN);
+        assert!(none.contains("last normalised residual none"), "{none}");
+        assert!(!none.contains("NaN"), "{none}");
+        let some = too_small(0.125);
+        assert!(some.contains("last normalised residual 1.25e-1;"), "{some}");
+    }
 }
