@@ -35,7 +35,27 @@ use mpm_mesh::{BoxMesh, PatchMesh, QuadraticMesh, RegularGrid};
 use mpm_solver::{
     FBar, FPatch, ImplicitSolver, LoadStepping, LockingTreatment, MaterialPoints, NewtonOptions,
     NoLocking, NoUpdate, NodalConstraints, Parts, PreviouslyConverged, SolverError,
+    UpdatedLagrangian,
 };
+
+use crate::variant::FormulationKind;
+
+/// Evaluates `$body` with the type alias `$f` naming the formulation
+/// `$kind` selects (one monomorphised run per formulation).
+macro_rules! with_formulation {
+    ($kind:expr, $f:ident, $body:expr) => {
+        match $kind {
+            FormulationKind::Ul => {
+                type $f = UpdatedLagrangian;
+                $body
+            }
+            FormulationKind::Pc => {
+                type $f = PreviouslyConverged;
+                $body
+            }
+        }
+    };
+}
 use nalgebra::Vector2;
 
 /// Young's modulus of the membrane.
@@ -77,6 +97,8 @@ pub struct Cook {
     /// Refinement: parent elements per side (triangles) or cells per
     /// width (grid).
     pub n: usize,
+    /// Statement of equilibrium (the studies use previously converged).
+    pub formulation: FormulationKind,
 }
 
 /// The outcome of a run.
@@ -140,7 +162,8 @@ const TIP_FIT_POINTS: usize = 6;
 
 /// The tip displacement in y extrapolated from the points nearest C: a
 /// least-squares fit u_y(X) ≈ a + b · (X − C) over the
-/// [`TIP_FIT_POINTS`] points whose initial positions X are nearest C,
+/// [`TIP_FIT_POINTS`] points whose initial positions X are nearest C
+/// (and any as near as the last of them),
 /// evaluated at C (a). The points lie within about a spacing of C, so the
 /// extrapolation error is second order in the spacing. NaN when the fit
 /// is singular.
@@ -156,11 +179,19 @@ pub fn extrapolated_tip(points: &MaterialPoints<2, (), ()>) -> f64 {
         })
         .collect();
     near.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // Every point as near as the last of the fit's: the lattice has points
+    // at equal distances from C, whose X = x − u differ in the last bits;
+    // taking some of a tie and not the others would let that rounding
+    // choose the fit.
+    let Some(last) = near.get(TIP_FIT_POINTS.min(near.len()).saturating_sub(1)) else {
+        return f64::NAN;
+    };
+    let reach = last.0 * (1.0 + 1e-9) + 1e-12 * WIDTH;
     let (mut normal, mut rhs) = (
         nalgebra::Matrix3::<f64>::zeros(),
         nalgebra::Vector3::zeros(),
     );
-    for (_, d, u) in near.iter().take(TIP_FIT_POINTS) {
+    for (_, d, u) in near.iter().take_while(|n| n.0 <= reach) {
         let row = nalgebra::Vector3::new(1.0, d[0], d[1]);
         normal += row * row.transpose();
         rhs += row * *u;
@@ -307,17 +338,19 @@ where
     }
     let law = HenckyElastic::new(YOUNG, cook.nu)?;
     let treatment = locking(&patches);
-    let solver: ImplicitSolver<2, Parts<LinearSimplex, PreviouslyConverged, _, K, NoUpdate, _>> =
-        ImplicitSolver::new(
-            LinearSimplex,
-            mesh,
-            law,
-            treatment,
-            NoUpdate,
-            c,
-            Traction::EdgeGaussPoints.newton(),
-        );
-    finish(solver, points, cook.steps, probe)
+    with_formulation!(cook.formulation, F, {
+        let solver: ImplicitSolver<2, Parts<LinearSimplex, F, _, K, NoUpdate, _>> =
+            ImplicitSolver::new(
+                LinearSimplex,
+                mesh,
+                law,
+                treatment,
+                NoUpdate,
+                c,
+                Traction::EdgeGaussPoints.newton(),
+            );
+        finish(solver, points, cook.steps, probe)
+    })
 }
 
 /// Cook's membrane on the children of a box of split six-node triangles
@@ -335,6 +368,13 @@ where
 {
     let h = WIDTH / cook.n as f64;
     let (lower, cells) = background(h);
+    // The lattice points sit at a quarter and three quarters of a cell;
+    // on a box starting at a node line in y they would lie on the
+    // children's diagonals, where a point's element (and its constant
+    // gradient) is decided by the rounding of its displacement, step by
+    // step. An eighth of a spacing up in y puts every point inside a
+    // child; x = 0 stays a node line for the clamp.
+    let lower = lower + Vector2::new(0.0, h / 8.0);
     // Parents of twice the spacing: the children have spacing h.
     let parents = BoxMesh::new(
         lower,
@@ -349,10 +389,12 @@ where
     let law = HenckyElastic::new(YOUNG, cook.nu)?;
     let treatment = locking(&patches);
     let options = Traction::BoundaryColumn.newton();
-    let solver: ImplicitSolver<2, Parts<LinearSimplex, PreviouslyConverged, _, K, NoUpdate, _>> =
-        ImplicitSolver::new(LinearSimplex, mesh, law, treatment, NoUpdate, c, options);
-    finish(solver, points, cook.steps, |p| {
-        Traction::BoundaryColumn.tip(p)
+    with_formulation!(cook.formulation, F, {
+        let solver: ImplicitSolver<2, Parts<LinearSimplex, F, _, K, NoUpdate, _>> =
+            ImplicitSolver::new(LinearSimplex, mesh, law, treatment, NoUpdate, c, options);
+        finish(solver, points, cook.steps, |p| {
+            Traction::BoundaryColumn.tip(p)
+        })
     })
 }
 
@@ -487,9 +529,11 @@ where
     let c = clamp(nodes, count, h);
     let law = HenckyElastic::new(YOUNG, cook.nu)?;
     let options = traction.newton();
-    let solver: ImplicitSolver<2, Parts<LinearMpm, PreviouslyConverged, _, K, NoUpdate, _>> =
-        ImplicitSolver::new(LinearMpm, grid, law, locking, NoUpdate, c, options);
-    finish(solver, points, cook.steps, |p| traction.tip(p))
+    with_formulation!(cook.formulation, F, {
+        let solver: ImplicitSolver<2, Parts<LinearMpm, F, _, K, NoUpdate, _>> =
+            ImplicitSolver::new(LinearMpm, grid, law, locking, NoUpdate, c, options);
+        finish(solver, points, cook.steps, |p| traction.tip(p))
+    })
 }
 
 /// The four runs of one refinement: triangles without and with F-patch
@@ -537,6 +581,8 @@ pub struct Footing {
     pub settlement: f64,
     /// Load steps.
     pub steps: usize,
+    /// Statement of equilibrium (the studies use previously converged).
+    pub formulation: FormulationKind,
 }
 
 /// Width and depth of the half layer.
@@ -648,17 +694,12 @@ where
     let count = grid.node_count();
     let nodes = (0..count).map(|v| grid.node_position(v).unwrap_or_else(|_| Vector2::zeros()));
     let (c, footing) = footing_constraints(nodes, count, f.settlement);
-    let solver: ImplicitSolver<2, Parts<LinearMpm, PreviouslyConverged, _, K, NoUpdate, _>> =
-        ImplicitSolver::new(
-            LinearMpm,
-            grid,
-            footing_law(f)?,
-            locking,
-            NoUpdate,
-            c,
-            newton(0.0),
-        );
-    Ok(footing_run(solver, points, &footing, f))
+    let law = footing_law(f)?;
+    Ok(with_formulation!(f.formulation, F, {
+        let solver: ImplicitSolver<2, Parts<LinearMpm, F, _, K, NoUpdate, _>> =
+            ImplicitSolver::new(LinearMpm, grid, law, locking, NoUpdate, c, newton(0.0));
+        footing_run(solver, points, &footing, f)
+    }))
 }
 
 /// The footing on the children of (`n`/2)² × 2 six-node triangles (node
@@ -704,17 +745,20 @@ where
         f.settlement,
     );
     let treatment = locking(&patches);
-    let solver: ImplicitSolver<2, Parts<LinearSimplex, PreviouslyConverged, _, K, NoUpdate, _>> =
-        ImplicitSolver::new(
-            LinearSimplex,
-            mesh,
-            footing_law(f)?,
-            treatment,
-            NoUpdate,
-            c,
-            newton(0.0),
-        );
-    Ok(footing_run(solver, points, &footing, f))
+    let law = footing_law(f)?;
+    Ok(with_formulation!(f.formulation, F, {
+        let solver: ImplicitSolver<2, Parts<LinearSimplex, F, _, K, NoUpdate, _>> =
+            ImplicitSolver::new(
+                LinearSimplex,
+                mesh,
+                law,
+                treatment,
+                NoUpdate,
+                c,
+                newton(0.0),
+            );
+        footing_run(solver, points, &footing, f)
+    }))
 }
 
 /// The four footing runs of one refinement, in the order of

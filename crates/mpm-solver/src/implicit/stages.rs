@@ -97,10 +97,16 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             self.options.weak_node_threshold * max(&support),
             self.options.weak_node_stiffness * max(&stiffness),
         );
+        // The support rule holds a node whose value *and* gradient vanish
+        // at its points (a fringe node of a domain or a spline); a node
+        // whose value vanishes but whose gradient does not (the node of a
+        // linear cell or simplex opposite a point on an edge) shapes the
+        // points' strains and stays free.
+        let support_stiffness_cut = self.options.weak_node_threshold * max(&stiffness);
         let weak: Vec<bool> = support
             .iter()
             .zip(&stiffness)
-            .map(|(&s, &k)| s < support_cut || k < stiffness_cut)
+            .map(|(&s, &k)| (s < support_cut && k < support_stiffness_cut) || k < stiffness_cut)
             .collect();
         let constraints = &self.constraints;
         let active_of_mesh = std::mem::take(&mut sys.active_of_mesh);
