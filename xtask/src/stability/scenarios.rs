@@ -7,6 +7,7 @@ use mpm_cases::locking::{
     Cook, CookResult, Footing, FootingCurve, Traction, footing_grid, footing_triangles, grid,
     triangles,
 };
+use mpm_cases::variant::FormulationKind;
 use mpm_solver::{FBar, FPatch, NoLocking, SolverError};
 
 use super::{Expect, Mode, Outcome, Row, guarded, outputs_intact, run_scene};
@@ -51,33 +52,37 @@ pub fn locking(mode: Mode) -> Vec<Row> {
     }
     let n = if mode == Mode::Quick { 4 } else { 16 };
     for nu in NUS {
-        let cook = Cook {
-            nu,
-            load: 1.0,
-            steps: 1,
-            n,
-        };
-        let scenario = format!("Cook's membrane, ν = {nu}, n = {n}");
-        type Run = fn(&Cook) -> Result<CookResult, SolverError>;
-        let runs: [(&str, Run); 4] = [
-            ("triangles, pc, none", |c| triangles(c, |_| NoLocking)),
-            ("triangles, pc, fpatch", |c| triangles(c, FPatch::new)),
-            ("grid, pc, none", |c| {
-                grid(c, NoLocking, Traction::EdgeGaussPoints)
-            }),
-            ("grid, pc, fbar", |c| {
-                grid(c, FBar::default(), Traction::EdgeGaussPoints)
-            }),
-        ];
-        for (variant, run) in runs {
-            let mut row = Row::new("locking", scenario.clone(), variant, Expect::Converge);
-            if let Some(r) = library(&mut row, || run(&cook)) {
-                let tip = r.tip * 100.0;
-                row.work = format!("1 step, {} iterations", r.iterations);
-                row.measured = format!("tip {tip:.4}");
-                row.value("tip", tip);
+        for formulation in [FormulationKind::Ul, FormulationKind::Pc] {
+            let cook = Cook {
+                nu,
+                load: 1.0,
+                steps: 1,
+                n,
+                formulation,
+            };
+            let scenario = format!("Cook's membrane, ν = {nu}, n = {n}");
+            type Run = fn(&Cook) -> Result<CookResult, SolverError>;
+            let runs: [(&str, Run); 4] = [
+                ("triangles, {f}, none", |c| triangles(c, |_| NoLocking)),
+                ("triangles, {f}, fpatch", |c| triangles(c, FPatch::new)),
+                ("grid, {f}, none", |c| {
+                    grid(c, NoLocking, Traction::EdgeGaussPoints)
+                }),
+                ("grid, {f}, fbar", |c| {
+                    grid(c, FBar::default(), Traction::EdgeGaussPoints)
+                }),
+            ];
+            for (variant, run) in runs {
+                let variant = variant.replace("{f}", &formulation.to_string());
+                let mut row = Row::new("locking", scenario.clone(), variant, Expect::Converge);
+                if let Some(r) = library(&mut row, || run(&cook)) {
+                    let tip = r.tip * 100.0;
+                    row.work = format!("1 step, {} iterations", r.iterations);
+                    row.measured = format!("tip {tip:.4}");
+                    row.value("tip", tip);
+                }
+                rows.push(row);
             }
-            rows.push(row);
         }
     }
     let (n, steps) = if mode == Mode::Quick {
@@ -86,42 +91,46 @@ pub fn locking(mode: Mode) -> Vec<Row> {
         (20, 12)
     };
     for nu in NUS {
-        let footing = Footing {
-            nu,
-            young: 1e4,
-            n,
-            settlement: 0.006,
-            steps,
-        };
-        let scenario = format!("Prandtl footing, ν = {nu}, n = {n}");
-        type Run = fn(&Footing) -> Result<FootingCurve, SolverError>;
-        let runs: [(&str, Run); 4] = [
-            ("triangles, pc, none", |f| {
-                footing_triangles(f, |_| NoLocking)
-            }),
-            ("triangles, pc, fpatch", |f| {
-                footing_triangles(f, FPatch::new)
-            }),
-            ("grid, pc, none", |f| footing_grid(f, NoLocking)),
-            ("grid, pc, fbar", |f| footing_grid(f, FBar::default())),
-        ];
-        for (variant, run) in runs {
-            let mut row = Row::new("locking", scenario.clone(), variant, Expect::Converge);
-            if let Some(c) = library(&mut row, || run(&footing)) {
-                row.work = format!("{} steps, {} iterations", c.points.len() - 1, c.iterations);
-                let plateau = c.points.last().map_or(0.0, |p| p.1);
-                let collapse = 2.0 + std::f64::consts::PI;
-                row.error = Some(plateau / collapse - 1.0);
-                row.measured = format!("q/k = {plateau:.3} (2 + π = {collapse:.3})");
-                row.value("pressure", plateau);
-                if let Some(f) = c.failure {
-                    row.outcome = Outcome::Error {
-                        error: "curve stopped early".into(),
-                        message: f,
-                    };
+        for formulation in [FormulationKind::Ul, FormulationKind::Pc] {
+            let footing = Footing {
+                nu,
+                young: 1e4,
+                n,
+                settlement: 0.006,
+                steps,
+                formulation,
+            };
+            let scenario = format!("Prandtl footing, ν = {nu}, n = {n}");
+            type Run = fn(&Footing) -> Result<FootingCurve, SolverError>;
+            let runs: [(&str, Run); 4] = [
+                ("triangles, {f}, none", |f| {
+                    footing_triangles(f, |_| NoLocking)
+                }),
+                ("triangles, {f}, fpatch", |f| {
+                    footing_triangles(f, FPatch::new)
+                }),
+                ("grid, {f}, none", |f| footing_grid(f, NoLocking)),
+                ("grid, {f}, fbar", |f| footing_grid(f, FBar::default())),
+            ];
+            for (variant, run) in runs {
+                let variant = variant.replace("{f}", &formulation.to_string());
+                let mut row = Row::new("locking", scenario.clone(), variant, Expect::Converge);
+                if let Some(c) = library(&mut row, || run(&footing)) {
+                    row.work = format!("{} steps, {} iterations", c.points.len() - 1, c.iterations);
+                    let plateau = c.points.last().map_or(0.0, |p| p.1);
+                    let collapse = 2.0 + std::f64::consts::PI;
+                    row.error = Some(plateau / collapse - 1.0);
+                    row.measured = format!("q/k = {plateau:.3} (2 + π = {collapse:.3})");
+                    row.value("pressure", plateau);
+                    if let Some(f) = c.failure {
+                        row.outcome = Outcome::Error {
+                            error: "curve stopped early".into(),
+                            message: f,
+                        };
+                    }
                 }
+                rows.push(row);
             }
-            rows.push(row);
         }
     }
     rows
@@ -423,27 +432,42 @@ pub fn explicit(mode: Mode) -> Vec<Row> {
     let disks = std::fs::read_to_string(super::scenes_dir().join("explicit_disks.toml"))
         .unwrap_or_default();
     let cells = if mode == Mode::Quick { 20 } else { 40 };
-    // An explicit scene runs one law (its materials may differ in density
-    // only): the pair is a density contrast of 10⁶, a wave-speed contrast
-    // of 10³ — the CFL step of a stiffness contrast of 10⁶.
+    // Two pairs with a wave-speed contrast of 10³: E = 10³ and 10⁹ Pa at
+    // one density (a `MaterialSet`, each point with its own modulus), and
+    // one law at densities 10³ and 10⁻³ kg/m³.
+    let stiff = disks.replacen(
+        "[[material]]",
+        "[[material]]\nname = \"stiff\"\nmodel = \"neo_hookean\"\nyoungs_modulus = 1.0e9\npoisson_ratio = 0.3\ndensity = 1000.0\n\n[[material]]",
+        1,
+    );
     let light = disks.replacen(
         "[[material]]",
         "[[material]]\nname = \"light\"\nmodel = \"neo_hookean\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\ndensity = 0.001\n\n[[material]]",
         1,
     );
+    let second_body = |text: &str, material: &str| {
+        let at = text.rfind("material = \"elastic\"").unwrap_or(0);
+        let mut t = text.to_owned();
+        t.replace_range(
+            at..at + "material = \"elastic\"".len(),
+            &format!("material = \"{material}\""),
+        );
+        t
+    };
     let scenarios = [
         (
+            "colliding disks, E = 10³ and 10⁹ Pa at ϱ = 10³ kg/m³ (wave speeds 1.2 and 1200 m/s), v = ±(1, 1) m/s",
+            second_body(&stiff, "stiff"),
+            vec![
+                "solver.end_time=0.25".to_owned(),
+                format!("mesh.cells=[{cells}, {cells}]"),
+            ],
+            10.0,
+            Expect::Converge,
+        ),
+        (
             "colliding disks, ϱ = 10³ and 10⁻³ kg/m³ (wave speeds 1.2 and 1200 m/s), v = ±(1, 1) m/s",
-            // The second body takes the light material.
-            {
-                let at = light.rfind("material = \"elastic\"").unwrap_or(0);
-                let mut t = light.clone();
-                t.replace_range(
-                    at..at + "material = \"elastic\"".len(),
-                    "material = \"light\"",
-                );
-                t
-            },
+            second_body(&light, "light"),
             vec![
                 "solver.end_time=0.25".to_owned(),
                 format!("mesh.cells=[{cells}, {cells}]"),
@@ -584,13 +608,26 @@ pub fn meshes() -> Vec<Row> {
         .map(|(scenario, text, expect)| {
             let mut row = Row::new("mesh", scenario, "MSH 4.1 → SimplexMesh<3>", expect);
             let started = Instant::now();
-            let result =
-                guarded(|| mpm_mesh::parse_msh::<3>(text.as_bytes()).map(|m| m.element_tags.len()));
-            let (outcome, elements) = Outcome::of(result, |_| 0);
+            // Accepted meshes are checked as `mpm run` checks them: the
+            // warnings of `SimplexMesh::quality`.
+            let result = guarded(|| {
+                mpm_mesh::parse_msh::<3>(text.as_bytes()).map(|m| {
+                    let warnings = match &m.elements {
+                        mpm_mesh::GmshElements::Linear(mesh) => mesh.quality().warnings(),
+                        mpm_mesh::GmshElements::Quadratic(_) => Vec::new(),
+                    };
+                    (m.element_tags.len(), warnings)
+                })
+            });
+            let (outcome, accepted) = Outcome::of(result, |_| 0);
             row.outcome = outcome;
             row.seconds = started.elapsed().as_secs_f64();
-            if let Some(n) = elements {
-                row.measured = format!("accepted: {n} elements");
+            if let Some((n, warnings)) = accepted {
+                row.measured = if warnings.is_empty() {
+                    format!("accepted: {n} elements, no warning")
+                } else {
+                    format!("accepted: {n} elements; warning: {}", warnings.join("; "))
+                };
             }
             row
         })
