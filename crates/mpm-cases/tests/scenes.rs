@@ -1590,7 +1590,7 @@ fn slivers_and_coincident_nodes_in_a_gmsh_mesh_are_warned_about() {
                 &[square[0], square[1], square[2], square[3], square[2]],
                 &[[1, 2, 3], [1, 5, 4]],
             ),
-            Some("nodes 2 and 4 share a position"),
+            Some("share a position (the first: nodes 2 and 4)"),
         ),
     ];
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("mesh_warnings");
