@@ -2,7 +2,7 @@
 //! domain update — chosen at run time by name and dispatched to a fully
 //! monomorphised solver.
 
-use mpm_basis::{Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
+use mpm_basis::{BoundaryBSpline, Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
     ConvectedCorners, CornerMidpoint, DetF, DiagF, DomainUpdater, DomainVolume, Flat, Formulation,
@@ -99,6 +99,9 @@ register_bases! {
     Cpdi2 => "cpdi2", Cpdi2, cpdi2;
     /// Quadratic B-spline.
     BSpline2 => "bspline2", QuadraticBSpline, point;
+    /// Quadratic B-spline with boundary-modified functions: interpolatory
+    /// at the grid's faces (a fixed face holds the body), no padding.
+    BSpline2Boundary => "bspline2_boundary", BoundaryBSpline, point;
 }
 
 named_enum!(

@@ -78,6 +78,7 @@ pub fn label(v: &Variant) -> String {
     match v.basis {
         BasisKind::Linear => "standard MPM".into(),
         BasisKind::BSpline2 => "quadratic B-spline".into(),
+        BasisKind::BSpline2Boundary => "quadratic B-spline, boundary-modified".into(),
         BasisKind::Cpdi2 => "CPDI2".into(),
         BasisKind::Gimp if domain_volume(v) => {
             format!("GIMP, {}{DOMAIN_VOLUME}", rule_label(v.domain_update))

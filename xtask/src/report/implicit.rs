@@ -92,6 +92,7 @@ fn family(v: &Variant) -> String {
     let basis = match v.basis {
         BasisKind::Linear => "standard MPM".to_owned(),
         BasisKind::BSpline2 => "quadratic B-spline".to_owned(),
+        BasisKind::BSpline2Boundary => "quadratic B-spline, boundary-modified".to_owned(),
         BasisKind::Cpdi2 => "CPDI2".to_owned(),
         BasisKind::Gimp => format!("GIMP, {}", rule_label(v.domain_update)),
     };
@@ -410,12 +411,12 @@ mod tests {
     #[test]
     fn grid_variants_are_the_ones_dispatch_runs() {
         let (grid, refused) = grid_variants();
-        // Standard MPM and the B-spline with and without F-bar, CPDI2, GIMP
-        // with each of its 8 rules and with F-bar: 14 families × 2
-        // formulations.
+        // Standard MPM and the two B-splines (plain and boundary-modified)
+        // with and without F-bar, CPDI2, GIMP with each of its 8 rules and
+        // with F-bar: 16 families × 2 formulations.
         assert_eq!(
             grid.len(),
-            28,
+            32,
             "{:?}",
             grid.iter().map(label).collect::<Vec<_>>()
         );

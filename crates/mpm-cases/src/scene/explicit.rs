@@ -59,7 +59,7 @@
 
 use std::time::Instant;
 
-use mpm_basis::{BasisFunction, LinearMpm, QuadraticBSpline};
+use mpm_basis::{BasisFunction, BoundaryBSpline, LinearMpm, QuadraticBSpline};
 use mpm_constitutive::{
     HenckyElastic, IncrementalLaw, MaterialSet, MaterialState, NeoHookean, Spectral, Tagged,
     VonMises,
@@ -226,8 +226,9 @@ fn dispatch<const D: usize>(
     match problem.variant.basis {
         BasisKind::Linear => run.with_basis(LinearMpm),
         BasisKind::BSpline2 => run.with_basis(QuadraticBSpline),
+        BasisKind::BSpline2Boundary => run.with_basis(BoundaryBSpline),
         other => Err(SolverError::InvalidInput(format!(
-            "basis = {other} has no domain update in time; the explicit solver takes linear or bspline2"
+            "basis = {other} has no domain update in time; the explicit solver takes linear, bspline2 or bspline2_boundary"
         ))),
     }
 }
