@@ -83,8 +83,7 @@ use mpm_cases::session::Session;
 use toml::{Table, Value};
 
 use fuzz_support::{
-    Ran, Rng, Worker, assert_no_findings, env_number, install_quiet_hook, peak_memory_kib,
-    restore_hook,
+    Config, Ran, Rng, Worker, assert_no_findings, install_quiet_hook, peak_memory_kib, restore_hook,
 };
 
 /// How far a base scene's mutants go.
@@ -123,31 +122,6 @@ const RUN_FRACTION: f64 = 0.25;
 
 // ---------------------------------------------------------------------------
 // Configuration, random source, worker with a time limit.
-
-/// Run parameters, from the environment.
-struct Config {
-    seed: u64,
-    cases: usize,
-    budget: Duration,
-    timeout: Duration,
-}
-
-impl Config {
-    fn from_env() -> Self {
-        let budget = env_number("MPM_FUZZ_BUDGET_SECS");
-        let cases = env_number("MPM_FUZZ_CASES");
-        Self {
-            seed: env_number("MPM_FUZZ_SEED").unwrap_or(16),
-            cases: match (cases, budget) {
-                (Some(n), _) => n as usize,
-                (None, Some(_)) => usize::MAX,
-                (None, None) => 1500,
-            },
-            budget: Duration::from_secs(budget.unwrap_or(20)),
-            timeout: Duration::from_secs(env_number("MPM_FUZZ_TIMEOUT_SECS").unwrap_or(10)),
-        }
-    }
-}
 
 // ---------------------------------------------------------------------------
 // Paths into a TOML document.
@@ -998,7 +972,7 @@ fn mutated_scenes_build_run_or_are_refused_with_a_typed_error() {
         replay(&path);
         return;
     }
-    let config = Config::from_env();
+    let config = Config::from_env(1500);
     let dir = scenes_dir();
     let mut corpus = Corpus::default();
     let bases: Vec<(&'static str, Cost, String, Value, Option<f64>)> = BASES

@@ -55,8 +55,7 @@ use mpm_mesh::{GmshElements, MeshError, PatchMesh, parse_msh};
 use nalgebra::SVector;
 
 use fuzz_support::{
-    Ran, Rng, Worker, assert_no_findings, env_number, install_quiet_hook, peak_memory_kib,
-    restore_hook,
+    Config, Ran, Rng, Worker, assert_no_findings, install_quiet_hook, peak_memory_kib, restore_hook,
 };
 
 /// The base meshes: (path relative to the workspace root, dimension).
@@ -74,31 +73,6 @@ const BASES: [(&str, usize); 9] = [
 
 // ---------------------------------------------------------------------------
 // Configuration, random source, worker with a time limit.
-
-/// Run parameters, from the environment.
-struct Config {
-    seed: u64,
-    cases: usize,
-    budget: Duration,
-    timeout: Duration,
-}
-
-impl Config {
-    fn from_env() -> Self {
-        let budget = env_number("MPM_FUZZ_BUDGET_SECS");
-        let cases = env_number("MPM_FUZZ_CASES");
-        Self {
-            seed: env_number("MPM_FUZZ_SEED").unwrap_or(16),
-            cases: match (cases, budget) {
-                (Some(n), _) => n as usize,
-                (None, Some(_)) => usize::MAX,
-                (None, None) => 4000,
-            },
-            budget: Duration::from_secs(budget.unwrap_or(20)),
-            timeout: Duration::from_secs(env_number("MPM_FUZZ_TIMEOUT_SECS").unwrap_or(10)),
-        }
-    }
-}
 
 // ---------------------------------------------------------------------------
 // The structure of an MSH file: which line holds what.
@@ -860,7 +834,7 @@ fn mutated_gmsh_files_are_read_or_refused_with_a_typed_error() {
         replay(&path);
         return;
     }
-    let config = Config::from_env();
+    let config = Config::from_env(4000);
     let bases: Vec<(String, Vec<String>, Index)> = BASES
         .iter()
         .map(|(path, dim)| {

@@ -162,3 +162,31 @@ pub fn assert_no_findings(lists: &[(&str, &Vec<String>)], replay: &str) {
         failures.join("\n")
     );
 }
+
+/// Run parameters, from the environment (`MPM_FUZZ_SEED`, default 16;
+/// `MPM_FUZZ_CASES`, default `default_cases`, unbounded when only a
+/// budget is given; `MPM_FUZZ_BUDGET_SECS`, default 20;
+/// `MPM_FUZZ_TIMEOUT_SECS`, default 10).
+pub struct Config {
+    pub seed: u64,
+    pub cases: usize,
+    pub budget: Duration,
+    pub timeout: Duration,
+}
+
+impl Config {
+    pub fn from_env(default_cases: usize) -> Self {
+        let budget = env_number("MPM_FUZZ_BUDGET_SECS");
+        let cases = env_number("MPM_FUZZ_CASES");
+        Self {
+            seed: env_number("MPM_FUZZ_SEED").unwrap_or(16),
+            cases: match (cases, budget) {
+                (Some(n), _) => n as usize,
+                (None, Some(_)) => usize::MAX,
+                (None, None) => default_cases,
+            },
+            budget: Duration::from_secs(budget.unwrap_or(20)),
+            timeout: Duration::from_secs(env_number("MPM_FUZZ_TIMEOUT_SECS").unwrap_or(10)),
+        }
+    }
+}
