@@ -289,6 +289,22 @@ pub struct ExplicitSetup<const D: usize> {
     pub velocity: Vec<SVector<f64, D>>,
     /// Constant point forces (point loads and tractions), per point index.
     pub point_forces: Vec<(usize, SVector<f64, D>)>,
+    /// Point forces that follow a curve over the simulated time (loads
+    /// with a `curve`, gravity included: m_p g on each point).
+    pub timed_forces: Vec<TimedForces<D>>,
+    /// Material-point fixities (point, component, velocity), from
+    /// `[[point_fixity]]`.
+    pub point_fixities: Vec<(usize, usize, f64)>,
+}
+
+/// Point forces of one explicit load with a curve: at simulated time t
+/// the force on point p is `force · curve.at(t)` (t in seconds).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimedForces<const D: usize> {
+    /// The factor over the simulated time.
+    pub curve: Curve,
+    /// (point, force where the curve is 1).
+    pub forces: Vec<(usize, SVector<f64, D>)>,
 }
 
 /// A scene ready to run.
@@ -853,6 +869,21 @@ impl<const D: usize> Problem<D> {
             let rows = c.points.get_ref();
             if rows.is_empty() {
                 return Err(src.at(&c.points, "a curve needs at least one [time, factor] row"));
+            }
+            if let Some(k) = rows
+                .iter()
+                .position(|r| !(r[0].is_finite() && r[1].is_finite()))
+            {
+                return Err(src.at(
+                    &c.points,
+                    format!(
+                        "curve `{}`: row {} is [{}, {}]; times and factors must be finite",
+                        c.name.get_ref(),
+                        k + 1,
+                        rows[k][0],
+                        rows[k][1]
+                    ),
+                ));
             }
             if let Some(k) = (1..rows.len()).find(|&k| rows[k][0] <= rows[k - 1][0]) {
                 return Err(src.at(
@@ -1525,6 +1556,7 @@ impl<const D: usize> Problem<D> {
         };
         let mut explicit_gravity = SVector::<f64, D>::zeros();
         let mut explicit_forces: Vec<(usize, SVector<f64, D>)> = Vec::new();
+        let mut timed_forces: Vec<TimedForces<D>> = Vec::new();
         for spec in &scene.loads {
             let kind = *spec.kind.get_ref();
             let curve = curve_of(&spec.curve)?;
@@ -1565,12 +1597,6 @@ impl<const D: usize> Problem<D> {
                 }
             }
             if explicit {
-                if let Some(c) = &spec.curve {
-                    return Err(src.at(
-                        c,
-                        "load curves follow the implicit solver's load factor; the explicit solver's loads are constant in time",
-                    ));
-                }
                 match kind {
                     LoadKind::Manufactured => {
                         return Err(src.at(
@@ -1578,11 +1604,13 @@ impl<const D: usize> Problem<D> {
                             "a manufactured load balances a quasi-static solution; the explicit solver does not take it",
                         ));
                     }
-                    LoadKind::Gravity => {
+                    // A gravity load with a curve is a force m_p g c(t) on
+                    // each point (below), its work external work.
+                    LoadKind::Gravity if curve == 0 => {
                         if let Some(b) = &spec.body {
                             return Err(src.at(
                                 b,
-                                "the explicit solver's gravity acts on every body: leave out `body`",
+                                "an explicit gravity load without a curve is the solver's gravitational field, on every body: leave out `body` (or give a `curve` to load one body's points)",
                             ));
                         }
                         let Some(a) = &spec.acceleration else {
@@ -1591,7 +1619,7 @@ impl<const D: usize> Problem<D> {
                         explicit_gravity += point::<D>(a, "`acceleration`", src)?;
                         continue;
                     }
-                    LoadKind::Point | LoadKind::Traction => {}
+                    LoadKind::Gravity | LoadKind::Point | LoadKind::Traction => {}
                 }
             }
             let mut forces: Vec<SVector<f64, D>> = Vec::new();
@@ -1738,14 +1766,21 @@ impl<const D: usize> Problem<D> {
                 continue;
             }
             if explicit {
-                // Point loads and tractions: constant forces on their points.
-                explicit_forces.extend(
-                    forces
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, f)| **f != SVector::<f64, D>::zeros())
-                        .map(|(p, f)| (p, *f)),
-                );
+                // Point loads and tractions: constant forces on their
+                // points, or forces scaled by their curve over time.
+                let nonzero = forces
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, f)| **f != SVector::<f64, D>::zeros())
+                    .map(|(p, f)| (p, *f));
+                if curve == 0 {
+                    explicit_forces.extend(nonzero);
+                } else {
+                    timed_forces.push(TimedForces {
+                        curve: curves[curve].clone(),
+                        forces: nonzero.collect(),
+                    });
+                }
                 continue;
             }
             if curve == 0 {
@@ -1943,6 +1978,47 @@ impl<const D: usize> Problem<D> {
                 ));
             }
         }
+        // Material-point fixities (explicit solver).
+        let mut point_fixities: Vec<(usize, usize, f64)> = Vec::new();
+        for spec in &scene.point_fixities {
+            if !explicit {
+                return Err(src.at(
+                    &spec.velocity,
+                    "material-point fixities are a condition of the explicit solver ([solver] kind = \"explicit\"); the implicit solver holds nodes ([[boundary]])",
+                ));
+            }
+            let values = axes_of::<D>(&spec.velocity, "velocity", src)?;
+            let range = match &spec.body {
+                Some(b) => bodies[lookup(&body_names, b, "body", src)?].points.clone(),
+                None => 0..n,
+            };
+            let region = Region::<D>::new(&spec.region, src)?;
+            let held: Vec<usize> = range
+                .filter(|&p| region.contains(&problem_points.position[p]))
+                .collect();
+            if held.is_empty() {
+                return Err(src.at(
+                    &spec.velocity,
+                    "the point fixity's region holds no material point",
+                ));
+            }
+            for p in held {
+                for (c, v) in values.iter().take(D).enumerate() {
+                    if let Some(v) = v {
+                        point_fixities.push((p, c, *v));
+                    }
+                }
+            }
+        }
+        // A later fixity of the same component replaces an earlier one.
+        point_fixities.reverse();
+        let mut seen = std::collections::BTreeSet::new();
+        point_fixities.retain(|&(p, c, _)| seen.insert((p, c)));
+        point_fixities.sort_by_key(|&(p, c, _)| (p, c));
+        // A held point starts at its held velocity.
+        for &(p, c, v) in &point_fixities {
+            initial_velocity[p][c] = v;
+        }
         let explicit = explicit_keys.map(|k| {
             // One call per component and value (each call sorts the list).
             let mut groups: BTreeMap<(usize, u64), Vec<usize>> = BTreeMap::new();
@@ -1969,6 +2045,8 @@ impl<const D: usize> Problem<D> {
                 fixities,
                 velocity: initial_velocity,
                 point_forces: explicit_forces,
+                timed_forces,
+                point_fixities,
             }
         });
 

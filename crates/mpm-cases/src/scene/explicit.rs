@@ -372,7 +372,13 @@ impl<const D: usize> Run<'_, '_, D> {
             ExplicitPoints::new(problem.position.clone(), problem.volume.clone(), 1.0)?;
         points.mass.clone_from(&problem.mass);
         points.velocity.clone_from(&setup.velocity);
+        // The constant forces, then those of the loads with a curve, whose
+        // values `scale_timed_forces` sets before every step.
         points.point_force.clone_from(&setup.point_forces);
+        for timed in &setup.timed_forces {
+            points.point_force.extend_from_slice(&timed.forces);
+        }
+        points.fixed_velocity.clone_from(&setup.point_fixities);
         for (state, &m) in points.material.iter_mut().zip(&problem.material_of_point) {
             *state = L::State::for_material(m);
         }
@@ -455,9 +461,13 @@ impl<const D: usize> Run<'_, '_, D> {
         let session_start = *solver.stage_times();
         while clock.index < outputs {
             let target = output_time(clock.index + 1);
-            solver.run_until(&mut points, target, |_, _, info| {
-                wall.observe(|| observer(ExplicitEvent::Step(*info)))
-            })?;
+            // As `ExplicitSolver::run_until`, with the curves' forces set
+            // at the start of every step.
+            while solver.time() < target * (1.0 - 1e-12) {
+                scale_timed_forces(&mut points.point_force, setup, solver.time());
+                let info = solver.step(&mut points, target - solver.time())?;
+                wall.observe(|| observer(ExplicitEvent::Step(info)))?;
+            }
             let energies = solver.energies(&points)?;
             clock.index += 1;
             clock.external_work = solver.external_work();
@@ -503,6 +513,27 @@ impl<const D: usize> Run<'_, '_, D> {
                 g2p: stage.g2p - session_start.g2p,
             },
         })
+    }
+}
+
+/// Sets the forces of the loads with a curve to their values at time `t`
+/// (s). They follow the constant forces in `forces`, in the order of
+/// `setup.timed_forces`. The solver takes a step's force as constant over
+/// the step (the momentum update of eq. 32 is forward Euler), so its
+/// external work stays consistent.
+fn scale_timed_forces<const D: usize>(
+    forces: &mut [(usize, SVector<f64, D>)],
+    setup: &ExplicitSetup<D>,
+    t: f64,
+) {
+    let mut at = setup.point_forces.len();
+    for timed in &setup.timed_forces {
+        let factor = timed.curve.at(t);
+        let n = timed.forces.len();
+        for (slot, &(_, f)) in forces[at..at + n].iter_mut().zip(&timed.forces) {
+            slot.1 = f * factor;
+        }
+        at += n;
     }
 }
 

@@ -37,6 +37,13 @@ pub struct Scene {
     /// Loads.
     #[serde(rename = "load", default, skip_serializing_if = "Vec::is_empty")]
     pub loads: Vec<LoadSpec>,
+    /// Material-point fixities (explicit solver).
+    #[serde(
+        rename = "point_fixity",
+        default,
+        skip_serializing_if = "Vec::is_empty"
+    )]
+    pub point_fixities: Vec<PointFixitySpec>,
     /// Load curves, referred to by name from loads and boundaries.
     #[serde(rename = "curve", default, skip_serializing_if = "Vec::is_empty")]
     pub curves: Vec<CurveSpec>,
@@ -387,6 +394,23 @@ pub struct BoundarySpec {
     pub velocity: Option<Spanned<Axes>>,
 }
 
+/// `[[point_fixity]]`: material-point fixities (explicit solver; the
+/// MPoint alternative to nodal fixities): the given velocity components
+/// of the material points in `region` (of `body`, if given) are held at
+/// the given values, on the points and, through a Lagrange multiplier per
+/// point, on the grid.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PointFixitySpec {
+    /// The points held: those inside the region at the start.
+    pub region: RegionSpec,
+    /// Only the points of this body (default: every body).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<Spanned<String>>,
+    /// The held components and their velocities (m/s).
+    pub velocity: Spanned<Axes>,
+}
+
 /// Kinds of load.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -442,7 +466,8 @@ pub struct LoadSpec {
     pub curve: Option<Spanned<String>>,
 }
 
-/// `[[curve]]`: a piecewise-linear factor over the load factor, from a
+/// `[[curve]]`: a piecewise-linear factor over the load factor (implicit
+/// solver) or over the simulated time in seconds (explicit solver), from a
 /// table of `[time, factor]` rows with increasing times; constant beyond
 /// the first and last row.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -450,7 +475,8 @@ pub struct LoadSpec {
 pub struct CurveSpec {
     /// Name the loads and boundaries use.
     pub name: Spanned<String>,
-    /// `[time, factor]` rows; time is the load factor, 0 to 1.
+    /// `[time, factor]` rows; time is the load factor, 0 to 1 (implicit
+    /// solver), or the simulated time in seconds (explicit solver).
     pub points: Spanned<Vec<[f64; 2]>>,
 }
 

@@ -64,7 +64,9 @@ mod program;
 pub mod region;
 mod runner;
 
-pub use build::{ExplicitSetup, Problem, ReactionOutput, SceneConstraints, SceneMotion};
+pub use build::{
+    ExplicitSetup, Problem, ReactionOutput, SceneConstraints, SceneMotion, TimedForces,
+};
 pub use explicit::{
     ExplicitEvent, ExplicitFrame, ExplicitObserver, ExplicitOutput, RunExplicit, run_explicit,
 };

@@ -131,16 +131,22 @@ pub fn update<const D: usize>(
 /// reaction force — by Gauss–Seidel sweeps over the held points (which
 /// couple where they share nodes) until every constraint holds to 1e-12 of
 /// the velocity scale or 100 sweeps. Nodes with a nodal fixity on the
-/// component do not move. `stencils` holds each held point's (node,
-/// weight) pairs.
+/// component do not move. `pairs[ends[k-1]..ends[k]]` (from 0 for the
+/// first) are held point k's (node, weight) pairs.
 ///
 /// Returns the largest remaining violation.
 pub fn hold_points<const D: usize>(
     grid: &mut GridState<D>,
     held: &[(usize, usize, f64)],
-    stencils: &[Vec<(usize, f64)>],
+    pairs: &[(usize, f64)],
+    ends: &[usize],
     fixities: &VelocityFixities,
 ) -> f64 {
+    let stencils = ends.iter().scan(0, |start, &end| {
+        let s = &pairs[*start..end];
+        *start = end;
+        Some(s)
+    });
     let fixed = |node: usize, c: usize| {
         fixities
             .entries()
@@ -161,7 +167,7 @@ pub fn hold_points<const D: usize>(
     let mut worst = 0.0;
     for _ in 0..100 {
         worst = 0.0f64;
-        for (&(_, c, target), stencil) in held.iter().zip(stencils) {
+        for (&(_, c, target), stencil) in held.iter().zip(stencils.clone()) {
             let (mut value, mut denominator) = (0.0, 0.0);
             for &(i, w) in stencil {
                 value += w * grid.velocity[i].new[c];

@@ -138,6 +138,8 @@ where
     external_work: f64,
     stage_times: ExplicitStageTimes,
     fixed_start: Vec<f64>,
+    /// The held points' (node, weight) pairs, and where each point's pairs end.
+    held_stencils: (Vec<(usize, f64)>, Vec<usize>),
 }
 
 impl<const D: usize, B, L, T, K> ExplicitSolver<D, B, L, T, K>
@@ -212,6 +214,7 @@ where
             external_work: 0.0,
             stage_times: ExplicitStageTimes::default(),
             fixed_start: Vec::new(),
+            held_stencils: (Vec::new(), Vec::new()),
         })
     }
 
@@ -428,9 +431,11 @@ where
     /// ([`grid_update::hold_points`]).
     fn hold_on_grid(&mut self, points: &PointsFor<D, L, T>) -> Result<(), (usize, PointFailure)> {
         let mut stencil = self.basis.new_stencil();
-        let mut stencils = Vec::with_capacity(points.fixed_velocity.len());
+        // Buffers kept between steps: no allocation per held point.
+        let (pairs, ends) = &mut self.held_stencils;
+        pairs.clear();
+        ends.clear();
         for &(p, _, _) in &points.fixed_velocity {
-            let mut pairs = Vec::with_capacity(B::MAX_NODES);
             p2g::visit_nodes(
                 &self.basis,
                 &self.mesh,
@@ -440,12 +445,13 @@ where
                 |i, w, _| pairs.push((i, w)),
             )
             .map_err(|e| (p, e))?;
-            stencils.push(pairs);
+            ends.push(pairs.len());
         }
         grid_update::hold_points(
             &mut self.grid,
             &points.fixed_velocity,
-            &stencils,
+            pairs,
+            ends,
             &self.fixities,
         );
         Ok(())
