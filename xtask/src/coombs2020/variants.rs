@@ -54,7 +54,8 @@ pub const GIMP_RULES: [DomainUpdateKind; 8] = [
     DomainUpdateKind::IncrementalVolumeCorrectedDiagF,
 ];
 
-/// Standard MPM, the quadratic B-spline, GIMP with every rule, GIMP
+/// Standard MPM, the quadratic B-spline (plain, with one padding cell, and
+/// boundary-modified), GIMP with every rule, GIMP
 /// without update integrating with its domain's volume (the paper's
 /// convention; with the other rules of Fig. 7 the two conventions agree to
 /// round-off) and CPDI2.
@@ -62,6 +63,7 @@ pub fn all() -> Vec<Variant> {
     let mut v = vec![
         linear(),
         variant(BasisKind::BSpline2, DomainUpdateKind::None),
+        variant(BasisKind::BSpline2Boundary, DomainUpdateKind::None),
     ];
     v.extend(GIMP_RULES.map(gimp));
     v.push(gimp_domain_volume(DomainUpdateKind::None));
