@@ -325,6 +325,15 @@ pub enum PointFailure {
         /// The velocity.
         velocity: Vec<f64>,
     },
+    /// The domain update failed (a basis with domains, e.g. GIMP).
+    #[error("domain update `{rule}`: {source}")]
+    Domain {
+        /// The rule's name.
+        rule: &'static str,
+        /// Why (boxed: it is large and rare).
+        #[source]
+        source: Box<DomainError>,
+    },
 }
 
 /// A residual for a message: "none" for the NaN that stands for no

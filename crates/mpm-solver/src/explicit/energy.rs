@@ -31,10 +31,10 @@ impl Energies {
 ///
 /// # Errors
 /// The law defines no stored energy for a point's state.
-pub fn energies<const D: usize, L: IncrementalLaw, T>(
+pub fn energies<const D: usize, L: IncrementalLaw, T, Dom>(
     law: &L,
     gravity: &SVector<f64, D>,
-    points: &ExplicitPoints<D, L::State, T>,
+    points: &ExplicitPoints<D, L::State, T, Dom>,
     external_work: f64,
 ) -> Result<Energies, SolverError> {
     let mut e = Energies {

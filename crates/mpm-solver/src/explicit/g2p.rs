@@ -172,15 +172,16 @@ pub fn finish<const D: usize, L: IncrementalLaw, T: super::Transfer<D>>(
 /// # Errors
 /// As [`super::p2g::visit_nodes`].
 #[inline(always)]
-pub fn interpolate<const D: usize, B: mpm_basis::BasisFunction<D, Domain = ()>>(
+pub fn interpolate<const D: usize, B: mpm_basis::BasisFunction<D>>(
     basis: &B,
     mesh: &B::Mesh,
     x: &SVector<f64, D>,
+    domain: &B::Domain,
     grid: &GridState<D>,
     stencil: &mut mpm_basis::Stencil<D>,
 ) -> Result<Gathered<D>, PointFailure> {
     let node_count = grid.mass.len();
-    if let Some(factors) = basis.tensor_factors(mesh, x, &()) {
+    if let Some(factors) = basis.tensor_factors(mesh, x, domain) {
         let t = factors.map_err(|e| PointFailure::Basis {
             position: x.iter().copied().collect(),
             source: crate::error::BasisFailure::Basis(e),
@@ -190,7 +191,7 @@ pub fn interpolate<const D: usize, B: mpm_basis::BasisFunction<D, Domain = ()>>(
         }
     }
     let mut g = Gathered::default();
-    super::p2g::visit_nodes(basis, mesh, x, node_count, stencil, |i, w, dw| {
+    super::p2g::visit_nodes(basis, mesh, x, domain, node_count, stencil, |i, w, dw| {
         gather_node(&mut g, grid, i, w, dw);
     })?;
     Ok(g)

@@ -56,15 +56,26 @@ pub use p2g::GridBuffer;
 pub use points::ExplicitPoints;
 pub use transfer::{Flip, FlipPic, Pic, Taylor, Transfer, VelocityGradient};
 
+use crate::domain::{DomainContext, DomainError, DomainUpdater, NoUpdate};
 use crate::error::{PointFailure, SolverError};
 use crate::locking::NoLocking;
 
 /// Points of one grid-to-point task per thread, times this.
 const TASKS_PER_THREAD: usize = 4;
 
-/// The points type of a solver with law `L` and transfer `T`.
+/// The points type of a solver with law `L` and transfer `T` and a basis
+/// without domains (standard MPM, B-splines).
 pub type PointsFor<const D: usize, L, T> =
     ExplicitPoints<D, <L as IncrementalLaw>::State, <T as Transfer<D>>::PointState>;
+
+/// The points type of a solver with basis `B`, law `L` and transfer `T`:
+/// [`PointsFor`] when the basis has no domain.
+pub type PointsOf<const D: usize, B, L, T> = ExplicitPoints<
+    D,
+    <L as IncrementalLaw>::State,
+    <T as Transfer<D>>::PointState,
+    <B as BasisFunction<D>>::Domain,
+>;
 
 /// Wall time spent in each stage since the solver was built, seconds.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -110,13 +121,19 @@ pub struct StepInfo {
 }
 
 /// The explicit solver, generic over the basis `B`, the incremental law
-/// `L`, the velocity transfer `T` and the dilatation treatment `K`
-/// ([`NoLocking`] or [`CellAveraged`]). Bases with a per-point domain
-/// (GIMP, CPDI2) need a domain update rule the explicit solver does not
-/// have yet; the bound `Domain = ()` admits standard MPM and B-splines.
-pub struct ExplicitSolver<const D: usize, B, L, T, K = NoLocking>
+/// `L`, the velocity transfer `T`, the dilatation treatment `K`
+/// ([`NoLocking`] or [`CellAveraged`]) and the domain update `R` of a
+/// basis with a domain per point ([`NoUpdate`] unless
+/// [`ExplicitSolver::with_domain_update`] names one). After every step
+/// each point's domain is updated from its new deformation gradient and
+/// the step's increment $\Delta F = I + \Delta t\,\nabla v$ (eq. 39):
+/// GIMP with the rules of the point's own deformation (Coombs et al. 2020
+/// eqs. 32–34, 38, 39). Rules that convect corners or mid-points with the
+/// grid (eq. 37, CPDI2) are refused at the first step with a typed error:
+/// the explicit solver does not interpolate a grid displacement at them.
+pub struct ExplicitSolver<const D: usize, B, L, T, K = NoLocking, R = NoUpdate>
 where
-    B: BasisFunction<D, Domain = ()>,
+    B: BasisFunction<D>,
 {
     basis: B,
     mesh: B::Mesh,
@@ -140,11 +157,15 @@ where
     fixed_start: Vec<f64>,
     /// The held points' (node, weight) pairs, and where each point's pairs end.
     held_stencils: (Vec<(usize, f64)>, Vec<usize>),
+    domain_rule: R,
+    /// Positions at the start of the step (the averaged path, bases with
+    /// domains only).
+    position_scratch: Vec<SVector<f64, D>>,
 }
 
 impl<const D: usize, B, L, T, K> ExplicitSolver<D, B, L, T, K>
 where
-    B: BasisFunction<D, Domain = ()>,
+    B: BasisFunction<D>,
     B::Mesh: ExplicitMesh<D>,
     L: IncrementalLaw,
     T: Transfer<D>,
@@ -215,7 +236,60 @@ where
             stage_times: ExplicitStageTimes::default(),
             fixed_start: Vec::new(),
             held_stencils: (Vec::new(), Vec::new()),
+            domain_rule: NoUpdate,
+            position_scratch: Vec::new(),
         })
+    }
+}
+
+impl<const D: usize, B, L, T, K, R> ExplicitSolver<D, B, L, T, K, R>
+where
+    B: BasisFunction<D>,
+    B::Mesh: ExplicitMesh<D>,
+    L: IncrementalLaw,
+    T: Transfer<D>,
+    K: DilatationTreatment,
+    R: DomainUpdater<D, B::Domain>,
+{
+    /// Whether the basis has a domain per point (`Domain` is not `()`).
+    const HAS_DOMAIN: bool = std::mem::size_of::<B::Domain>() > 0;
+
+    /// The same solver with the domain update `rule` (GIMP: one of the
+    /// rules of the point's own deformation, e.g. [`crate::StretchU`]).
+    pub fn with_domain_update<R2: DomainUpdater<D, B::Domain>>(
+        self,
+        rule: R2,
+    ) -> ExplicitSolver<D, B, L, T, K, R2> {
+        ExplicitSolver {
+            basis: self.basis,
+            mesh: self.mesh,
+            law: self.law,
+            transfer: self.transfer,
+            locking: self.locking,
+            fixities: self.fixities,
+            options: self.options,
+            node_count: self.node_count,
+            node_position: self.node_position,
+            buffers: self.buffers,
+            grid: self.grid,
+            grad_scratch: self.grad_scratch,
+            cell_scratch: self.cell_scratch,
+            cell_sums: self.cell_sums,
+            max_signal: self.max_signal,
+            time: self.time,
+            steps: self.steps,
+            external_work: self.external_work,
+            stage_times: self.stage_times,
+            fixed_start: self.fixed_start,
+            held_stencils: self.held_stencils,
+            domain_rule: rule,
+            position_scratch: self.position_scratch,
+        }
+    }
+
+    /// The domain update.
+    pub fn domain_update(&self) -> &R {
+        &self.domain_rule
     }
 
     /// The background mesh.
@@ -282,7 +356,7 @@ where
 
     /// The stable increment of eq. (45) times the CFL factor, or the fixed
     /// increment, for the points' current state.
-    pub fn time_increment(&mut self, points: &PointsFor<D, L, T>) -> f64 {
+    pub fn time_increment(&mut self, points: &PointsOf<D, B, L, T>) -> f64 {
         match self.options.time_step {
             TimeStep::Fixed(dt) => dt,
             TimeStep::Cfl { factor } => factor * self.stable_increment(points),
@@ -292,7 +366,7 @@ where
     /// The stable increment of eq. (45), $h/\max_p(c_p + \|v_p\|)$, for the
     /// points' current state (from the last step's grid-to-point stage, or
     /// computed from the points before the first step).
-    pub fn stable_increment(&mut self, points: &PointsFor<D, L, T>) -> f64 {
+    pub fn stable_increment(&mut self, points: &PointsOf<D, B, L, T>) -> f64 {
         let law = &self.law;
         let signal = *self.max_signal.get_or_insert_with(|| {
             (0..points.len())
@@ -316,7 +390,7 @@ where
     /// checkpoint) to go back.
     pub fn step(
         &mut self,
-        points: &mut PointsFor<D, L, T>,
+        points: &mut PointsOf<D, B, L, T>,
         max_dt: f64,
     ) -> Result<StepInfo, SolverError> {
         let dt = self.time_increment(points).min(max_dt);
@@ -343,6 +417,14 @@ where
                 point,
                 reason,
             };
+        if points.domain.len() != points.len() || points.domain0.len() != points.len() {
+            return Err(SolverError::InvalidInput(format!(
+                "{} points but {} domains and {} initial domains",
+                points.len(),
+                points.domain.len(),
+                points.domain0.len()
+            )));
+        }
         self.hold_fixed_points(points)?;
         let clock = std::time::Instant::now();
         self.point_to_grid(points).map_err(|e| fail(self, e))?;
@@ -385,9 +467,9 @@ where
     /// As [`ExplicitSolver::step`], or the observer's error.
     pub fn run_until(
         &mut self,
-        points: &mut PointsFor<D, L, T>,
+        points: &mut PointsOf<D, B, L, T>,
         end_time: f64,
-        mut observer: impl FnMut(&Self, &PointsFor<D, L, T>, &StepInfo) -> Result<(), SolverError>,
+        mut observer: impl FnMut(&Self, &PointsOf<D, B, L, T>, &StepInfo) -> Result<(), SolverError>,
     ) -> Result<usize, SolverError> {
         let start = self.steps;
         // Stop within a relative rounding of the end rather than take a
@@ -404,7 +486,7 @@ where
     ///
     /// # Errors
     /// A law without a stored energy.
-    pub fn energies(&self, points: &PointsFor<D, L, T>) -> Result<Energies, SolverError> {
+    pub fn energies(&self, points: &PointsOf<D, B, L, T>) -> Result<Energies, SolverError> {
         energy::energies(&self.law, &self.options.gravity, points, self.external_work)
     }
 
@@ -412,7 +494,7 @@ where
     /// components (so that the momentum they bring to the grid is the
     /// prescribed one) and keeps the fixed position components of the step's
     /// start.
-    fn hold_fixed_points(&mut self, points: &mut PointsFor<D, L, T>) -> Result<(), SolverError> {
+    fn hold_fixed_points(&mut self, points: &mut PointsOf<D, B, L, T>) -> Result<(), SolverError> {
         self.fixed_start.clear();
         for &(p, c, v) in &points.fixed_velocity {
             if p >= points.len() || c >= D || !v.is_finite() {
@@ -429,7 +511,7 @@ where
 
     /// The grid side of the material-point fixities
     /// ([`grid_update::hold_points`]).
-    fn hold_on_grid(&mut self, points: &PointsFor<D, L, T>) -> Result<(), (usize, PointFailure)> {
+    fn hold_on_grid(&mut self, points: &PointsOf<D, B, L, T>) -> Result<(), (usize, PointFailure)> {
         let mut stencil = self.basis.new_stencil();
         // Buffers kept between steps: no allocation per held point.
         let (pairs, ends) = &mut self.held_stencils;
@@ -440,6 +522,7 @@ where
                 &self.basis,
                 &self.mesh,
                 &points.position[p],
+                &points.domain[p],
                 self.node_count,
                 &mut stencil,
                 |i, w, _| pairs.push((i, w)),
@@ -457,7 +540,7 @@ where
         Ok(())
     }
 
-    fn point_force_power(&self, points: &PointsFor<D, L, T>) -> f64 {
+    fn point_force_power(&self, points: &PointsOf<D, B, L, T>) -> f64 {
         points
             .point_force
             .iter()
@@ -465,7 +548,10 @@ where
             .sum()
     }
 
-    fn point_to_grid(&mut self, points: &PointsFor<D, L, T>) -> Result<(), (usize, PointFailure)> {
+    fn point_to_grid(
+        &mut self,
+        points: &PointsOf<D, B, L, T>,
+    ) -> Result<(), (usize, PointFailure)> {
         let threads = rayon::current_num_threads().max(1);
         self.buffers
             .resize_with(threads, || GridBuffer::new(self.node_count));
@@ -478,6 +564,7 @@ where
             volume0: &points.volume0,
             tau: &points.tau,
             transfer: &points.transfer,
+            domain: &points.domain,
         };
         let (basis, mesh, gravity, node_position) = (
             &self.basis,
@@ -512,6 +599,7 @@ where
                 &self.basis,
                 &self.mesh,
                 &points.position,
+                &points.domain,
                 &points.point_force,
                 &mut self.buffers[0],
                 &mut stencil,
@@ -523,11 +611,12 @@ where
     /// The fused grid-to-point update (no dilatation averaging).
     fn grid_to_point(
         &mut self,
-        points: &mut PointsFor<D, L, T>,
+        points: &mut PointsOf<D, B, L, T>,
         dt: f64,
     ) -> Result<f64, (usize, PointFailure)> {
         let per = task_size(points.len());
         let (basis, mesh, grid, law) = (&self.basis, &self.mesh, &self.grid, &self.law);
+        let rule = &self.domain_rule;
         let alpha = self.transfer.alpha();
         let p = points;
         let results: Vec<Result<f64, (usize, PointFailure)>> = (
@@ -540,38 +629,56 @@ where
             p.transfer.par_chunks_mut(per),
             p.mass.par_chunks(per),
             p.volume0.par_chunks(per),
+            p.domain.par_chunks_mut(per),
+            p.domain0.par_chunks(per),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(task, (x, v, f, vol, tau, mat, tr, mass, vol0))| {
-                let mut stencil = basis.new_stencil();
-                let mut signal: f64 = 0.0;
-                for k in 0..x.len() {
-                    let point = task * per + k;
-                    let g = g2p::interpolate(basis, mesh, &x[k], grid, &mut stencil)
+            .map(
+                |(task, (x, v, f, vol, tau, mat, tr, mass, vol0, dom, dom0))| {
+                    let mut stencil = basis.new_stencil();
+                    let mut signal: f64 = 0.0;
+                    for k in 0..x.len() {
+                        let point = task * per + k;
+                        let g = g2p::interpolate(basis, mesh, &x[k], &dom[k], grid, &mut stencil)
+                            .map_err(|e| (point, e))?;
+                        let x_start = x[k];
+                        g2p::move_point(alpha, dt, &g, &mut x[k], &mut v[k]);
+                        let s = g2p::finish::<D, L, T>(
+                            law,
+                            dt,
+                            &g.grad,
+                            None,
+                            PointMut {
+                                f: &mut f[k],
+                                volume: &mut vol[k],
+                                volume0: vol0[k],
+                                tau: &mut tau[k],
+                                material: &mut mat[k],
+                                transfer: &mut tr[k],
+                                mass: mass[k],
+                                velocity: &v[k],
+                            },
+                        )
                         .map_err(|e| (point, e))?;
-                    g2p::move_point(alpha, dt, &g, &mut x[k], &mut v[k]);
-                    let s = g2p::finish::<D, L, T>(
-                        law,
-                        dt,
-                        &g.grad,
-                        None,
-                        PointMut {
-                            f: &mut f[k],
-                            volume: &mut vol[k],
-                            volume0: vol0[k],
-                            tau: &mut tau[k],
-                            material: &mut mat[k],
-                            transfer: &mut tr[k],
-                            mass: mass[k],
-                            velocity: &v[k],
-                        },
-                    )
-                    .map_err(|e| (point, e))?;
-                    signal = signal.max(s);
-                }
-                Ok(signal)
-            })
+                        if Self::HAS_DOMAIN {
+                            update_domain::<D, B, R>(
+                                rule,
+                                dt,
+                                &g.grad,
+                                &f[k],
+                                &x_start,
+                                &x[k],
+                                &dom0[k],
+                                &mut dom[k],
+                            )
+                            .map_err(|e| (point, e))?;
+                        }
+                        signal = signal.max(s);
+                    }
+                    Ok(signal)
+                },
+            )
             .collect();
         first_error(results.into_iter())
     }
@@ -582,13 +689,16 @@ where
     /// with the gradients of eq. (52).
     fn grid_to_point_averaged(
         &mut self,
-        points: &mut PointsFor<D, L, T>,
+        points: &mut PointsOf<D, B, L, T>,
         dt: f64,
     ) -> Result<f64, (usize, PointFailure)> {
         let n = points.len();
         let per = task_size(n);
         self.grad_scratch.resize(n, SMatrix::zeros());
         self.cell_scratch.resize(n, 0);
+        if Self::HAS_DOMAIN {
+            self.position_scratch.clone_from(&points.position);
+        }
         let (basis, mesh, grid) = (&self.basis, &self.mesh, &self.grid);
         let alpha = self.transfer.alpha();
         let p = &mut *points;
@@ -597,14 +707,15 @@ where
             p.velocity.par_chunks_mut(per),
             self.grad_scratch.par_chunks_mut(per),
             self.cell_scratch.par_chunks_mut(per),
+            p.domain.par_chunks(per),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(task, (x, v, grads, cells))| {
+            .map(|(task, (x, v, grads, cells, dom))| {
                 let mut stencil = basis.new_stencil();
                 for k in 0..x.len() {
                     let point = task * per + k;
-                    let g = g2p::interpolate(basis, mesh, &x[k], grid, &mut stencil)
+                    let g = g2p::interpolate(basis, mesh, &x[k], &dom[k], grid, &mut stencil)
                         .map_err(|e| (point, e))?;
                     cells[k] = mesh.cell_of(&x[k]).unwrap_or(usize::MAX);
                     g2p::move_point(alpha, dt, &g, &mut x[k], &mut v[k]);
@@ -628,23 +739,31 @@ where
             }
         }
         let (law, sums, cells) = (&self.law, &self.cell_sums, &self.cell_scratch);
+        let (rule, starts) = (&self.domain_rule, &self.position_scratch);
         let p = points;
         let results: Vec<Result<f64, (usize, PointFailure)>> = (
-            p.f.par_chunks_mut(per),
-            p.volume.par_chunks_mut(per),
-            p.tau.par_chunks_mut(per),
-            p.material.par_chunks_mut(per),
-            p.transfer.par_chunks_mut(per),
-            self.grad_scratch.par_chunks(per),
-            cells.par_chunks(per),
-            p.velocity.par_chunks(per),
-            p.mass.par_chunks(per),
-            p.volume0.par_chunks(per),
+            (
+                p.f.par_chunks_mut(per),
+                p.volume.par_chunks_mut(per),
+                p.tau.par_chunks_mut(per),
+                p.material.par_chunks_mut(per),
+                p.transfer.par_chunks_mut(per),
+                self.grad_scratch.par_chunks(per),
+            ),
+            (
+                cells.par_chunks(per),
+                p.velocity.par_chunks(per),
+                p.mass.par_chunks(per),
+                p.volume0.par_chunks(per),
+                p.domain.par_chunks_mut(per),
+                p.domain0.par_chunks(per),
+                p.position.par_chunks(per),
+            ),
         )
             .into_par_iter()
             .enumerate()
             .map(
-                |(task, (f, vol, tau, mat, tr, grads, cells, v, mass, vol0))| {
+                |(task, ((f, vol, tau, mat, tr, grads), (cells, v, mass, vol0, dom, dom0, x)))| {
                     let mut signal: f64 = 0.0;
                     for k in 0..f.len() {
                         let point = task * per + k;
@@ -674,6 +793,19 @@ where
                             },
                         )
                         .map_err(|e| (point, e))?;
+                        if Self::HAS_DOMAIN {
+                            update_domain::<D, B, R>(
+                                rule,
+                                dt,
+                                grad,
+                                &f[k],
+                                &starts[point],
+                                &x[k],
+                                &dom0[k],
+                                &mut dom[k],
+                            )
+                            .map_err(|e| (point, e))?;
+                        }
                         signal = signal.max(s);
                     }
                     Ok(signal)
@@ -682,6 +814,52 @@ where
             .collect();
         first_error(results.into_iter())
     }
+}
+
+/// A point's domain after its step (the explicit counterpart of the
+/// implicit solver's update after a converged load step): the rule sees
+/// the new $F$, the step's $\Delta F = I + \Delta t\,\nabla v$ (eq. 39,
+/// the unmodified gradient, as $F$ follows it) and the positions before
+/// and after. Rules that read the grid displacement at corners or
+/// mid-points get an error from it.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn update_domain<const D: usize, B: BasisFunction<D>, R: DomainUpdater<D, B::Domain>>(
+    rule: &R,
+    dt: f64,
+    grad: &SMatrix<f64, D, D>,
+    f: &nalgebra::Matrix3<f64>,
+    position_previous: &SVector<f64, D>,
+    position: &SVector<f64, D>,
+    initial: &B::Domain,
+    domain: &mut B::Domain,
+) -> Result<(), PointFailure> {
+    let delta_f = g2p::increment(dt, grad);
+    let ctx = DomainContext {
+        initial,
+        previous: domain,
+        f,
+        delta_f: &delta_f,
+        position_previous,
+        position,
+    };
+    let no_field = |x: &SVector<f64, D>| {
+        Err(DomainError::Inadmissible {
+            rule: R::NAME,
+            reason: format!(
+                "it reads the grid displacement at {:?}, which the explicit solver does not interpolate; use a rule of the point's own deformation (none, det_f, diag_f, stretch, volume_corrected_diag_f, incremental_volume_corrected_diag_f)",
+                x.as_slice()
+            ),
+        })
+    };
+    let updated = rule
+        .update(&ctx, no_field)
+        .map_err(|source| PointFailure::Domain {
+            rule: R::NAME,
+            source: Box::new(source),
+        })?;
+    *domain = updated;
+    Ok(())
 }
 
 /// Points per grid-to-point task.

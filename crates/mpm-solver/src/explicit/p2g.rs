@@ -76,7 +76,7 @@ impl<const D: usize> GridBuffer<D> {
 
 /// What the scatter reads from the points.
 #[derive(Debug, Clone, Copy)]
-pub struct PointsView<'a, const D: usize, T> {
+pub struct PointsView<'a, const D: usize, T, Dom = ()> {
     /// Positions $x^n_p$.
     pub position: &'a [SVector<f64, D>],
     /// Velocities $v^n_p$.
@@ -89,6 +89,8 @@ pub struct PointsView<'a, const D: usize, T> {
     pub tau: &'a [Matrix3<f64>],
     /// Transfer states.
     pub transfer: &'a [T],
+    /// The basis's domains.
+    pub domain: &'a [Dom],
 }
 
 /// The failure of the basis at `x`.
@@ -99,18 +101,19 @@ fn basis_failure<const D: usize>(x: &SVector<f64, D>, source: BasisFailure) -> P
     }
 }
 
-/// Streams the supporting nodes of the point at `x` into `visit`
-/// ([`BasisFunction::for_each_node`]), checking that every node id lies
-/// below `node_count`.
+/// Streams the supporting nodes of the point at `x` with its basis domain
+/// `domain` into `visit` ([`BasisFunction::for_each_node`]), checking that
+/// every node id lies below `node_count`.
 ///
 /// # Errors
 /// The basis cannot be evaluated at `x`, or it returned a node outside the
 /// mesh (a bug of the basis; nothing past that node is visited).
 #[inline(always)]
-pub fn visit_nodes<const D: usize, B: BasisFunction<D, Domain = ()>>(
+pub fn visit_nodes<const D: usize, B: BasisFunction<D>>(
     basis: &B,
     mesh: &B::Mesh,
     x: &SVector<f64, D>,
+    domain: &B::Domain,
     node_count: usize,
     stencil: &mut Stencil<D>,
     mut visit: impl FnMut(usize, f64, &SVector<f64, D>),
@@ -118,7 +121,7 @@ pub fn visit_nodes<const D: usize, B: BasisFunction<D, Domain = ()>>(
     let fail = |source| basis_failure(x, source);
     let mut outside = None;
     basis
-        .for_each_node(mesh, x, &(), stencil, |i, w, g| {
+        .for_each_node(mesh, x, domain, stencil, |i, w, g| {
             if i < node_count {
                 if outside.is_none() {
                     visit(i, w, g);
@@ -151,7 +154,7 @@ pub fn visit_nodes<const D: usize, B: BasisFunction<D, Domain = ()>>(
 pub fn scatter<const D: usize, B, T>(
     basis: &B,
     mesh: &B::Mesh,
-    points: &PointsView<'_, D, T::PointState>,
+    points: &PointsView<'_, D, T::PointState, B::Domain>,
     node_position: &[SVector<f64, D>],
     gravity: &SVector<f64, D>,
     range: Range<usize>,
@@ -159,7 +162,7 @@ pub fn scatter<const D: usize, B, T>(
     stencil: &mut Stencil<D>,
 ) -> Result<(), (usize, PointFailure)>
 where
-    B: BasisFunction<D, Domain = ()>,
+    B: BasisFunction<D>,
     T: Transfer<D>,
 {
     let node_count = buffer.len();
@@ -172,7 +175,8 @@ where
         let state = &points.transfer[p];
         let stress = points.tau[p].fixed_view::<D, D>(0, 0) * points.volume0[p];
         let body = gravity * m;
-        if let Some(factors) = basis.tensor_factors(mesh, x, &()) {
+        let domain = &points.domain[p];
+        if let Some(factors) = basis.tensor_factors(mesh, x, domain) {
             let affine = T::affine(state);
             if !T::TAYLOR || affine.is_some() {
                 let t = factors.map_err(|e| (p, basis_failure(x, BasisFailure::Basis(e))))?;
@@ -195,7 +199,7 @@ where
                 continue;
             }
         }
-        visit_nodes(basis, mesh, x, node_count, stencil, |i, w, g| {
+        visit_nodes(basis, mesh, x, domain, node_count, stencil, |i, w, g| {
             let wm = w * m;
             let carried = if T::TAYLOR {
                 T::nodal_velocity(v, state, &(node_position[i] - x))
@@ -220,10 +224,11 @@ where
 ///
 /// # Errors
 /// As [`scatter`].
-pub fn scatter_point_forces<const D: usize, B: BasisFunction<D, Domain = ()>>(
+pub fn scatter_point_forces<const D: usize, B: BasisFunction<D>>(
     basis: &B,
     mesh: &B::Mesh,
     position: &[SVector<f64, D>],
+    domain: &[B::Domain],
     forces: &[(usize, SVector<f64, D>)],
     buffer: &mut GridBuffer<D>,
     stencil: &mut Stencil<D>,
@@ -236,6 +241,7 @@ pub fn scatter_point_forces<const D: usize, B: BasisFunction<D, Domain = ()>>(
             basis,
             mesh,
             &position[*p],
+            &domain[*p],
             node_count,
             stencil,
             |i, w, _| {

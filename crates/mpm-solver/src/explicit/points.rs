@@ -5,11 +5,13 @@ use nalgebra::{Matrix3, SVector};
 use crate::error::SolverError;
 
 /// Material points for the explicit solver (struct of arrays). `S` is the
-/// law's state ([`mpm_constitutive::IncrementalLaw::State`]) and `T` the
-/// transfer's ([`super::Transfer::PointState`]), so neither an elastic law
-/// nor a PIC transfer costs memory per point.
+/// law's state ([`mpm_constitutive::IncrementalLaw::State`]), `T` the
+/// transfer's ([`super::Transfer::PointState`]) and `Dom` the basis's
+/// domain ([`mpm_basis::BasisFunction::Domain`]: `()` for standard MPM and
+/// B-splines, the half-lengths for GIMP), so neither an elastic law, nor a
+/// PIC transfer, nor a basis without domains costs memory per point.
 #[derive(Debug, Clone)]
-pub struct ExplicitPoints<const D: usize, S, T> {
+pub struct ExplicitPoints<const D: usize, S, T, Dom = ()> {
     /// Position $x_p$.
     pub position: Vec<SVector<f64, D>>,
     /// Velocity $v_p$.
@@ -40,9 +42,14 @@ pub struct ExplicitPoints<const D: usize, S, T> {
     /// ([`super::grid_update::hold_points`]) and after every step — and its
     /// position moves with it; empty when the scene has none.
     pub fixed_velocity: Vec<(usize, usize, f64)>,
+    /// The basis's domain of each point (GIMP half-lengths), updated after
+    /// every step by the solver's [`crate::domain::DomainUpdater`].
+    pub domain: Vec<Dom>,
+    /// The domains at the start (what rules such as eq. 34 scale).
+    pub domain0: Vec<Dom>,
 }
 
-impl<const D: usize, S, T> ExplicitPoints<D, S, T> {
+impl<const D: usize, S, T, Dom> ExplicitPoints<D, S, T, Dom> {
     /// Number of points.
     pub fn len(&self) -> usize {
         self.position.len()
@@ -52,9 +59,55 @@ impl<const D: usize, S, T> ExplicitPoints<D, S, T> {
     pub fn is_empty(&self) -> bool {
         self.position.is_empty()
     }
+
+    /// Sets every point's velocity from a function of its position.
+    pub fn set_velocity(&mut self, v: impl Fn(&SVector<f64, D>) -> SVector<f64, D>) {
+        for (x, vel) in self.position.iter().zip(&mut self.velocity) {
+            *vel = v(x);
+        }
+    }
+
+    /// The Cauchy stress $\sigma_p = \tau_p / J_p$ of point `p`.
+    pub fn cauchy(&self, p: usize) -> Matrix3<f64> {
+        self.tau[p] / self.f[p].determinant()
+    }
 }
 
 impl<const D: usize, S: Copy + Default, T: Copy + Default> ExplicitPoints<D, S, T> {
+    /// The same points with a domain each (initial and current), for a
+    /// basis with domains, e.g. `Gimp::initial_domain(x, half_lengths)`
+    /// per point.
+    ///
+    /// # Errors
+    /// A number of domains other than the number of points.
+    pub fn with_domains<Dom: Copy>(
+        self,
+        domains: Vec<Dom>,
+    ) -> Result<ExplicitPoints<D, S, T, Dom>, SolverError> {
+        if domains.len() != self.len() {
+            return Err(SolverError::InvalidInput(format!(
+                "{} points but {} domains",
+                self.len(),
+                domains.len()
+            )));
+        }
+        Ok(ExplicitPoints {
+            position: self.position,
+            velocity: self.velocity,
+            mass: self.mass,
+            volume0: self.volume0,
+            volume: self.volume,
+            f: self.f,
+            tau: self.tau,
+            material: self.material,
+            transfer: self.transfer,
+            point_force: self.point_force,
+            fixed_velocity: self.fixed_velocity,
+            domain0: domains.clone(),
+            domain: domains,
+        })
+    }
+
     /// Unstressed points at rest with the given positions and volumes and a
     /// uniform density.
     ///
@@ -90,19 +143,9 @@ impl<const D: usize, S: Copy + Default, T: Copy + Default> ExplicitPoints<D, S, 
             transfer: vec![T::default(); n],
             point_force: Vec::new(),
             fixed_velocity: Vec::new(),
+            domain: vec![(); n],
+            domain0: vec![(); n],
             position,
         })
-    }
-
-    /// Sets every point's velocity from a function of its position.
-    pub fn set_velocity(&mut self, v: impl Fn(&SVector<f64, D>) -> SVector<f64, D>) {
-        for (x, vel) in self.position.iter().zip(&mut self.velocity) {
-            *vel = v(x);
-        }
-    }
-
-    /// The Cauchy stress $\sigma_p = \tau_p / J_p$ of point `p`.
-    pub fn cauchy(&self, p: usize) -> Matrix3<f64> {
-        self.tau[p] / self.f[p].determinant()
     }
 }

@@ -14,6 +14,7 @@ use super::{
     DilatationTreatment, ExplicitOptions, ExplicitPoints, ExplicitSolver, Flip, FlipPic, PointsFor,
     Taylor, TimeStep, Transfer, VelocityFixities,
 };
+use crate::domain::{DomainUpdater, NoUpdate};
 use crate::error::SolverError;
 use crate::locking::NoLocking;
 
@@ -43,8 +44,8 @@ pub fn block(
 /// $\sum_p (u_p - a\sin\beta X_p)^2$: the squared error of the axial
 /// displacements of `points` (started at `x0`) against the first mode of
 /// the bar at an instant where its amplitude is `a`.
-pub fn mode_squared_error<S, T>(
-    points: &ExplicitPoints<2, S, T>,
+pub fn mode_squared_error<S, T, Dom>(
+    points: &ExplicitPoints<2, S, T, Dom>,
     x0: &[Vector2<f64>],
     a: f64,
     beta: f64,
@@ -91,6 +92,29 @@ where
     B: BasisFunction<2, Domain = (), Mesh = RegularGrid<2>>,
     T: Transfer<2>,
 {
+    vibrating_bar_with(basis, NoUpdate, transfer, cells, cfl, periods, v0)
+}
+
+/// [`vibrating_bar`] with a basis that may have domains (GIMP: each
+/// point's initial half-lengths are half its spacing, h/4) and the domain
+/// update `rule`.
+///
+/// # Errors
+/// Set-up and solver errors.
+pub fn vibrating_bar_with<B, R, T>(
+    basis: B,
+    rule: R,
+    transfer: T,
+    cells: usize,
+    cfl: f64,
+    periods: f64,
+    v0: f64,
+) -> Result<Bar, SolverError>
+where
+    B: BasisFunction<2, Mesh = RegularGrid<2>>,
+    R: DomainUpdater<2, B::Domain>,
+    T: Transfer<2>,
+{
     let (l, e, rho): (f64, f64, f64) = (25.0, 100.0, 1.0);
     let h = 2.0 * l / cells as f64;
     let pad = B::PADDING as f64 + 1.0;
@@ -102,7 +126,12 @@ where
     let (x0, vol) = block(Vector2::new(-l, 0.0), Vector2::new(l, h), h, 2);
     let beta = std::f64::consts::PI / (2.0 * l);
     let omega = beta * (e / rho).sqrt();
-    let mut points: PointsFor<2, NeoHookean, T> = ExplicitPoints::new(x0.clone(), vol, rho)?;
+    let domains = x0
+        .iter()
+        .map(|x| B::initial_domain(x, &Vector2::new(h / 4.0, h / 4.0)))
+        .collect();
+    let points: PointsFor<2, NeoHookean, T> = ExplicitPoints::new(x0.clone(), vol, rho)?;
+    let mut points = points.with_domains(domains)?;
     points.set_velocity(|x| Vector2::new(v0 * (beta * x.x).sin(), 0.0));
     let mut fixed = VelocityFixities::new();
     fixed.fix(0..grid.node_count(), 1);
@@ -118,7 +147,8 @@ where
         NoLocking,
         fixed,
         options,
-    )?;
+    )?
+    .with_domain_update(rule);
     let period = 2.0 * std::f64::consts::PI / omega;
     let amplitude = v0 / omega;
     let (mut sum, mut count) = (0.0, 0usize);
@@ -260,20 +290,46 @@ pub fn dynamic_collapse<B>(
 where
     B: BasisFunction<2, Domain = (), Mesh = RegularGrid<2>>,
 {
-    let pad = B::PADDING as f64 * h;
-    let nx = (24.0 / h).round() as usize + B::PADDING;
-    let ny = (10.0 / h).round() as usize + B::PADDING;
+    dynamic_collapse_with(basis, NoUpdate, h, alpha, end)
+}
+
+/// [`dynamic_collapse`] with a basis that may have domains (GIMP: each
+/// point's initial half-lengths are half its spacing, h/6) and the domain
+/// update `rule`.
+pub fn dynamic_collapse_with<B, R>(
+    basis: B,
+    rule: R,
+    h: f64,
+    alpha: f64,
+    end: f64,
+) -> Result<(f64, f64, f64), SolverError>
+where
+    B: BasisFunction<2, Mesh = RegularGrid<2>>,
+    R: DomainUpdater<2, B::Domain>,
+{
+    // A padding cell below and beside the block at least: a GIMP point on
+    // the base may dip below it by rounding (the held nodes stop it there).
+    let padding = B::PADDING.max(1);
+    let pad = padding as f64 * h;
+    let nx = (24.0 / h).round() as usize + padding;
+    let ny = (10.0 / h).round() as usize + padding;
     let grid = RegularGrid::new(
         Vector2::new(-pad, -pad),
         Vector2::new(h, h),
-        [nx + B::PADDING, ny + B::PADDING],
+        [nx + padding, ny + padding],
     )?;
     let (x0, vol) = block(Vector2::zeros(), Vector2::new(8.0, 8.0), h, 3);
+    let l0 = h / 6.0;
+    let domains = x0
+        .iter()
+        .map(|x| B::initial_domain(x, &Vector2::new(l0, l0)))
+        .collect();
     let law = Spectral::new(VonMises::new(1e6, 0.3, 20e3, 0.0)?)?;
-    let mut points: ExplicitPoints<2, _, ()> = ExplicitPoints::new(x0, vol, 1000.0)?;
-    let nodes = [nx + B::PADDING + 1, ny + B::PADDING + 1];
+    let points: ExplicitPoints<2, _, ()> = ExplicitPoints::new(x0, vol, 1000.0)?;
+    let mut points = points.with_domains(domains)?;
+    let nodes = [nx + padding + 1, ny + padding + 1];
     let mut fixed = VelocityFixities::new();
-    let rows = B::PADDING + 1; // the boundary row or column and the padding beyond it
+    let rows = padding + 1; // the boundary row or column and the padding beyond it
     fixed.fix(0..nodes[0] * rows, 1);
     fixed.fix(
         (0..nodes[1]).flat_map(|j| (0..rows).map(move |i| j * nodes[0] + i)),
@@ -291,9 +347,9 @@ where
         NoLocking,
         fixed,
         options,
-    )?;
+    )?
+    .with_domain_update(rule);
     solver.run_until(&mut points, end, |_, _, _| Ok(()))?;
-    let l0 = h / 6.0;
     let extent = points.position.iter().map(|x| x.x + l0).fold(0.0, f64::max);
     let height = points.position.iter().map(|x| x.y + l0).fold(0.0, f64::max);
     Ok((extent, height, solver.energies(&points)?.kinetic))
