@@ -566,8 +566,13 @@ fn malformed_scenes_are_refused_with_a_located_message() {
         ),
         (
             "steps = 2",
-            "kind = \"explicit\"\nend_time = 1.0\nbasis = \"gimp\"",
-            "bad.toml:29:9: basis = gimp needs a domain per point and a rule that updates it in time, which the explicit solver does not have yet",
+            "kind = \"explicit\"\nend_time = 1.0\nbasis = \"cpdi2\"",
+            "bad.toml:29:9: basis = cpdi2 convects its corners with the grid, which the explicit solver does not do",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\nbasis = \"gimp\"\ndomain_update = \"midpoint\"",
+            "bad.toml:30:17: domain_update = midpoint convects corners or mid-points with the grid, which the explicit solver does not do",
         ),
         (
             "steps = 2",
@@ -663,12 +668,7 @@ fn malformed_scenes_are_refused_with_a_located_message() {
         (
             "acceleration = [0.0, -10.0]",
             "acceleration = [0.0, -10.0]\nbody = \"b\"",
-            "bad.toml:25:8: the explicit solver's gravity acts on every body: leave out `body`",
-        ),
-        (
-            "acceleration = [0.0, -10.0]",
-            "acceleration = [0.0, -10.0]\ncurve = \"c\"\n\n[[curve]]\nname = \"c\"\npoints = [[0.0, 0.0], [1.0, 1.0]]",
-            "bad.toml:25:9: load curves follow the implicit solver's load factor; the explicit solver's loads are constant in time",
+            "bad.toml:25:8: an explicit gravity load without a curve is the solver's gravitational field, on every body: leave out `body`",
         ),
         (
             "kind = \"gravity\"\nacceleration = [0.0, -10.0]",

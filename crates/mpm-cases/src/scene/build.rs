@@ -2763,10 +2763,6 @@ fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>
             given(SolverSpec::given(&s.formulation), s.formulation.span()),
         ),
         (
-            "domain_update",
-            given(SolverSpec::given(&s.domain_update), s.domain_update.span()),
-        ),
-        (
             "gimp_volume",
             given(SolverSpec::given(&s.gimp_volume), s.gimp_volume.span()),
         ),
@@ -2811,13 +2807,22 @@ fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>
         ));
     }
     if let Some(b) = &s.basis
-        && matches!(b.get_ref(), BasisKind::Gimp | BasisKind::Cpdi2)
+        && *b.get_ref() == BasisKind::Cpdi2
     {
         return Err(src.at(
             b,
+            "basis = cpdi2 convects its corners with the grid, which the explicit solver does not do; use basis = \"bspline2\" (the default), \"bspline2_boundary\", \"linear\" or \"gimp\"",
+        ));
+    }
+    let update = *s.domain_update.get_ref();
+    if matches!(
+        update,
+        DomainUpdateKind::CornerMidpoint | DomainUpdateKind::Midpoint | DomainUpdateKind::Cpdi2
+    ) {
+        return Err(src.at(
+            &s.domain_update,
             format!(
-                "basis = {} needs a domain per point and a rule that updates it in time, which the explicit solver does not have yet; use basis = \"bspline2\" (the default) or \"linear\"",
-                b.get_ref()
+                "domain_update = {update} convects corners or mid-points with the grid, which the explicit solver does not do; it takes the rules of each point's own deformation: none, det_f, diag_f, stretch, volume_corrected_diag_f, incremental_volume_corrected_diag_f"
             ),
         ));
     }

@@ -6,13 +6,15 @@
 //! points, with a [`Checkpoint`] to resume from when asked for.
 //!
 //! The solvers are compiled once per dimension, here ([`RunExplicit`]):
-//! basis (`linear`, `bspline2`) × law (closed-form `NeoHookean`,
-//! `Spectral<HenckyElastic>`, `Spectral<VonMises>`, each alone or as a
-//! `MaterialSet` when the scene's materials differ in more than density)
-//! × transfer (`FlipPic`, which covers PIC, FLIP and their blend;
-//! `Taylor`) × dilatation (`NoLocking`, `CellAveraged`): 48 solvers per
-//! dimension. A scene of one material (or of materials that differ in
-//! density only) runs the law alone: no tag per point, one wave modulus.
+//! basis (`linear`, `bspline2`, `bspline2_boundary`, and `gimp` with its
+//! `domain_update` rule chosen at run time) × law (closed-form
+//! `NeoHookean`, `Spectral<HenckyElastic>`, `Spectral<VonMises>`, each
+//! alone or as a `MaterialSet` when the scene's materials differ in more
+//! than density) × transfer (`FlipPic`, which covers PIC, FLIP and their
+//! blend; `Taylor`) × dilatation (`NoLocking`, `CellAveraged`): 96
+//! solvers per dimension. A scene of one material (or of materials that
+//! differ in density only) runs the law alone: no tag per point, one wave
+//! modulus; a basis without domains stores none.
 //!
 //! ```
 //! use mpm_cases::run::RunControl;
@@ -59,24 +61,27 @@
 
 use std::time::Instant;
 
-use mpm_basis::{BasisFunction, BoundaryBSpline, LinearMpm, QuadraticBSpline};
+use mpm_basis::{BasisFunction, BoundaryBSpline, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_constitutive::{
     HenckyElastic, IncrementalLaw, MaterialSet, MaterialState, NeoHookean, Spectral, Tagged,
     VonMises,
 };
 use mpm_mesh::RegularGrid;
 use mpm_solver::explicit::{
-    DilatationTreatment, Energies, ExplicitStageTimes, PointsFor, StepInfo, VelocityGradient,
+    DilatationTreatment, Energies, ExplicitStageTimes, PointsFor, PointsOf, StepInfo,
+    VelocityGradient,
 };
 use mpm_solver::{
-    CellAveraged, ExplicitOptions, ExplicitPoints, ExplicitSolver, Flat, FlipPic, NoLocking,
-    RunState, RunSummary, SolverError, Taylor, Transfer,
+    CellAveraged, DetF, DiagF, DisplacementField, DomainContext, DomainError, DomainUpdater,
+    ExplicitOptions, ExplicitPoints, ExplicitSolver, Flat, FlipPic,
+    IncrementalVolumeCorrectedDiagF, NoLocking, NoUpdate, RunState, RunSummary, SolverError,
+    StretchU, Taylor, Transfer, VolumeCorrectedDiagF,
 };
 use nalgebra::{Matrix3, SVector};
 
 use crate::material::MaterialModel;
-use crate::run::{Checkpoint, HistoryOutput, RunControl, Snapshot};
-use crate::variant::{BasisKind, LockingKind};
+use crate::run::{Checkpoint, DomainBounds, HistoryOutput, RunControl, Snapshot};
+use crate::variant::{BasisKind, DomainUpdateKind, LockingKind};
 
 use super::build::{ExplicitSetup, Problem, SceneMesh};
 use super::format::TransferKind;
@@ -216,7 +221,10 @@ fn dispatch<const D: usize>(
     problem: &Problem<D>,
     control: &RunControl,
     observer: &mut ExplicitObserver<'_>,
-) -> Result<ExplicitOutput, SolverError> {
+) -> Result<ExplicitOutput, SolverError>
+where
+    SVector<f64, D>: FlatState,
+{
     parts(problem)?;
     let run = Run {
         problem,
@@ -224,12 +232,47 @@ fn dispatch<const D: usize>(
         observer,
     };
     match problem.variant.basis {
-        BasisKind::Linear => run.with_basis(LinearMpm),
-        BasisKind::BSpline2 => run.with_basis(QuadraticBSpline),
-        BasisKind::BSpline2Boundary => run.with_basis(BoundaryBSpline),
+        BasisKind::Linear => run.with_basis(LinearMpm, NoUpdate),
+        BasisKind::BSpline2 => run.with_basis(QuadraticBSpline, NoUpdate),
+        BasisKind::BSpline2Boundary => run.with_basis(BoundaryBSpline, NoUpdate),
+        BasisKind::Gimp => run.with_basis(Gimp, GimpRule(problem.variant.domain_update)),
         other => Err(SolverError::InvalidInput(format!(
-            "basis = {other} has no domain update in time; the explicit solver takes linear, bspline2 or bspline2_boundary"
+            "basis = {other} convects its corners with the grid, which the explicit solver does not do; it takes linear, bspline2, bspline2_boundary or gimp"
         ))),
+    }
+}
+
+/// The GIMP domain rule of the scene, chosen when the run starts (one
+/// solver for every rule rather than one per rule: a branch per point and
+/// step, beside the stress update). The builder admits the rules of the
+/// point's own deformation only.
+#[derive(Debug, Clone, Copy)]
+struct GimpRule(DomainUpdateKind);
+
+impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for GimpRule {
+    const NAME: &'static str = "gimp";
+
+    fn update(
+        &self,
+        ctx: &DomainContext<'_, D, SVector<f64, D>>,
+        field: impl DisplacementField<D>,
+    ) -> Result<SVector<f64, D>, DomainError> {
+        match self.0 {
+            DomainUpdateKind::None => NoUpdate.update(ctx, field),
+            DomainUpdateKind::DetF => DetF.update(ctx, field),
+            DomainUpdateKind::DiagF => DiagF.update(ctx, field),
+            DomainUpdateKind::Stretch => StretchU.update(ctx, field),
+            DomainUpdateKind::VolumeCorrectedDiagF => VolumeCorrectedDiagF.update(ctx, field),
+            DomainUpdateKind::IncrementalVolumeCorrectedDiagF => {
+                IncrementalVolumeCorrectedDiagF.update(ctx, field)
+            }
+            other => Err(DomainError::Inadmissible {
+                rule: "gimp",
+                reason: format!(
+                    "domain_update = {other} convects corners or mid-points with the grid, which the explicit solver does not do"
+                ),
+            }),
+        }
     }
 }
 
@@ -242,9 +285,11 @@ struct Run<'a, 'o, const D: usize> {
 impl<const D: usize> Run<'_, '_, D> {
     /// The law: one, or a [`MaterialSet`] when the materials differ in
     /// more than their density.
-    fn with_basis<B>(self, basis: B) -> Result<ExplicitOutput, SolverError>
+    fn with_basis<B, R>(self, basis: B, rule: R) -> Result<ExplicitOutput, SolverError>
     where
-        B: BasisFunction<D, Domain = (), Mesh = RegularGrid<D>>,
+        B: BasisFunction<D, Mesh = RegularGrid<D>>,
+        B::Domain: FlatState + DomainBounds<D>,
+        R: DomainUpdater<D, B::Domain>,
     {
         let Some(material) = self.problem.materials.first() else {
             return Err(SolverError::InvalidInput(
@@ -259,7 +304,7 @@ impl<const D: usize> Run<'_, '_, D> {
             (|$p:ident| $make:expr) => {{
                 if one_law {
                     let $p = &material.params;
-                    self.with_law(basis, $make)
+                    self.with_law(basis, rule, $make)
                 } else {
                     let laws = materials
                         .iter()
@@ -268,7 +313,7 @@ impl<const D: usize> Run<'_, '_, D> {
                             Ok($make)
                         })
                         .collect::<Result<Vec<_>, _>>()?;
-                    self.with_law(basis, MaterialSet::new(laws)?)
+                    self.with_law(basis, rule, MaterialSet::new(laws)?)
                 }
             }};
         }
@@ -295,9 +340,11 @@ impl<const D: usize> Run<'_, '_, D> {
     }
 
     /// The transfer.
-    fn with_law<B, L>(self, basis: B, law: L) -> Result<ExplicitOutput, SolverError>
+    fn with_law<B, R, L>(self, basis: B, rule: R, law: L) -> Result<ExplicitOutput, SolverError>
     where
-        B: BasisFunction<D, Domain = (), Mesh = RegularGrid<D>>,
+        B: BasisFunction<D, Mesh = RegularGrid<D>>,
+        B::Domain: FlatState + DomainBounds<D>,
+        R: DomainUpdater<D, B::Domain>,
         L: IncrementalLaw,
         L::State: FlatState,
     {
@@ -305,23 +352,26 @@ impl<const D: usize> Run<'_, '_, D> {
         let alpha = setup.alpha;
         match setup.transfer {
             TransferKind::Pic | TransferKind::Flip | TransferKind::Blend => {
-                self.with_transfer(basis, law, FlipPic { alpha })
+                self.with_transfer(basis, rule, law, FlipPic { alpha })
             }
             TransferKind::Tpic | TransferKind::Tflip => {
-                self.with_transfer(basis, law, Taylor { alpha })
+                self.with_transfer(basis, rule, law, Taylor { alpha })
             }
         }
     }
 
     /// The dilatation treatment.
-    fn with_transfer<B, L, T>(
+    fn with_transfer<B, R, L, T>(
         self,
         basis: B,
+        rule: R,
         law: L,
         transfer: T,
     ) -> Result<ExplicitOutput, SolverError>
     where
-        B: BasisFunction<D, Domain = (), Mesh = RegularGrid<D>>,
+        B: BasisFunction<D, Mesh = RegularGrid<D>>,
+        B::Domain: FlatState + DomainBounds<D>,
+        R: DomainUpdater<D, B::Domain>,
         L: IncrementalLaw,
         L::State: FlatState,
         T: Transfer<D>,
@@ -329,8 +379,8 @@ impl<const D: usize> Run<'_, '_, D> {
     {
         let (_, setup) = parts(self.problem)?;
         match setup.locking {
-            LockingKind::None => self.with(basis, law, transfer, NoLocking),
-            LockingKind::CellAveraged => self.with(basis, law, transfer, CellAveraged),
+            LockingKind::None => self.with(basis, rule, law, transfer, NoLocking),
+            LockingKind::CellAveraged => self.with(basis, rule, law, transfer, CellAveraged),
             other => Err(SolverError::InvalidInput(format!(
                 "locking = {other} is an implicit treatment; the explicit solver takes none or cell_averaged"
             ))),
@@ -338,15 +388,18 @@ impl<const D: usize> Run<'_, '_, D> {
     }
 
     /// Runs with every type chosen.
-    fn with<B, L, T, K>(
+    fn with<B, R, L, T, K>(
         self,
         basis: B,
+        rule: R,
         law: L,
         transfer: T,
         locking: K,
     ) -> Result<ExplicitOutput, SolverError>
     where
-        B: BasisFunction<D, Domain = (), Mesh = RegularGrid<D>>,
+        B: BasisFunction<D, Mesh = RegularGrid<D>>,
+        B::Domain: FlatState + DomainBounds<D>,
+        R: DomainUpdater<D, B::Domain>,
         L: IncrementalLaw,
         L::State: FlatState,
         T: Transfer<D>,
@@ -367,9 +420,14 @@ impl<const D: usize> Run<'_, '_, D> {
             locking,
             setup.fixities.clone(),
             options,
-        )?;
-        let mut points: PointsFor<D, L, T> =
+        )?
+        .with_domain_update(rule);
+        let points: PointsFor<D, L, T> =
             ExplicitPoints::new(problem.position.clone(), problem.volume.clone(), 1.0)?;
+        let domains = (problem.position.iter().zip(&problem.half_lengths))
+            .map(|(x, l)| B::initial_domain(x, l))
+            .collect();
+        let mut points: PointsOf<D, B, L, T> = points.with_domains(domains)?;
         points.mass.clone_from(&problem.mass);
         points.velocity.clone_from(&setup.velocity);
         // The constant forces, then those of the loads with a curve, whose
@@ -408,7 +466,7 @@ impl<const D: usize> Run<'_, '_, D> {
                 let clock = Clock::from_checkpoint(c)?;
                 let scene_tags: Vec<u32> =
                     points.material.iter().map(FlatState::material).collect();
-                points = read_points::<D, L::State, T::PointState>(&c.points, points)?;
+                points = read_points::<D, L::State, T::PointState, B::Domain>(&c.points, points)?;
                 // A tag past the set's end would index no law: the
                 // checkpoint must be of this scene's materials.
                 if let Some(p) =
@@ -631,8 +689,8 @@ impl Clock {
 
 /// A snapshot of the points after `steps` steps, with a checkpoint when
 /// the run keeps them.
-fn snapshot<const D: usize, S: FlatState, T: FlatState>(
-    points: &ExplicitPoints<D, S, T>,
+fn snapshot<const D: usize, S: FlatState, T: FlatState, Dom: FlatState + DomainBounds<D>>(
+    points: &ExplicitPoints<D, S, T, Dom>,
     initial: &[SVector<f64, D>],
     time: f64,
     control: &RunControl,
@@ -664,8 +722,8 @@ fn snapshot<const D: usize, S: FlatState, T: FlatState>(
 /// The points as plain arrays: positions, displacements from `initial`,
 /// velocities, Cauchy stresses, deformation gradients, volumes, plastic
 /// strains.
-fn snapshot_of<const D: usize, S: FlatState, T: FlatState>(
-    points: &ExplicitPoints<D, S, T>,
+fn snapshot_of<const D: usize, S: FlatState, T: FlatState, Dom: DomainBounds<D>>(
+    points: &ExplicitPoints<D, S, T, Dom>,
     initial: &[SVector<f64, D>],
     time: f64,
 ) -> Snapshot {
@@ -688,6 +746,12 @@ fn snapshot_of<const D: usize, S: FlatState, T: FlatState>(
             .material
             .iter()
             .map(FlatState::plastic_strain)
+            .collect(),
+        domain_bounds: points
+            .domain
+            .iter()
+            .zip(&points.position)
+            .filter_map(|(d, x)| d.bounds(x).map(|(lo, hi)| (pad(&lo), pad(&hi))))
             .collect(),
         ..Snapshot::default()
     }
@@ -774,6 +838,23 @@ impl FlatState for () {
     fn read(_: &[f64]) -> Self {}
 }
 
+/// A GIMP domain: its half-lengths.
+macro_rules! flat_half_lengths {
+    ($($d:literal),*) => {$(
+        impl FlatState for SVector<f64, $d> {
+            const LEN: usize = $d;
+            fn write(&self, out: &mut Vec<f64>) {
+                out.extend_from_slice(self.as_slice());
+            }
+            fn read(from: &[f64]) -> Self {
+                Self::from_column_slice(&from[..$d])
+            }
+        }
+    )*};
+}
+
+flat_half_lengths!(2, 3);
+
 impl<const D: usize> FlatState for VelocityGradient<D> {
     const LEN: usize = D * D;
     fn write(&self, out: &mut Vec<f64>) {
@@ -785,18 +866,20 @@ impl<const D: usize> FlatState for VelocityGradient<D> {
 }
 
 /// Numbers per point of [`write_points`].
-fn point_len<const D: usize, S: FlatState, T: FlatState>() -> usize {
-    2 * D + 3 + 18 + S::LEN + T::LEN
+fn point_len<const D: usize, S: FlatState, T: FlatState, Dom: FlatState>() -> usize {
+    2 * D + 3 + 18 + S::LEN + T::LEN + Dom::LEN
 }
 
 /// The points' evolving state as numbers: the count, then per point its
 /// position, velocity, mass, initial and current volume, F, τ, the law's
-/// and the transfer's state. Point forces are the scene's and not stored.
-fn write_points<const D: usize, S: FlatState, T: FlatState>(
-    points: &ExplicitPoints<D, S, T>,
+/// and the transfer's state, the basis's domain (none for bases without
+/// one). Point forces, fixities and initial domains are the scene's and
+/// not stored.
+fn write_points<const D: usize, S: FlatState, T: FlatState, Dom: FlatState>(
+    points: &ExplicitPoints<D, S, T, Dom>,
 ) -> Vec<f64> {
     let n = points.len();
-    let mut out = Vec::with_capacity(1 + n * point_len::<D, S, T>());
+    let mut out = Vec::with_capacity(1 + n * point_len::<D, S, T, Dom>());
     out.push(n as f64);
     for p in 0..n {
         out.extend_from_slice(points.position[p].as_slice());
@@ -806,18 +889,19 @@ fn write_points<const D: usize, S: FlatState, T: FlatState>(
         out.extend_from_slice(points.tau[p].as_slice());
         points.material[p].write(&mut out);
         points.transfer[p].write(&mut out);
+        points.domain[p].write(&mut out);
     }
     out
 }
 
 /// [`write_points`] read back into `points` (the scene's points, which
 /// keep their point forces).
-fn read_points<const D: usize, S: FlatState, T: FlatState>(
+fn read_points<const D: usize, S: FlatState, T: FlatState, Dom: FlatState>(
     flat: &[f64],
-    mut points: ExplicitPoints<D, S, T>,
-) -> Result<ExplicitPoints<D, S, T>, SolverError> {
+    mut points: ExplicitPoints<D, S, T, Dom>,
+) -> Result<ExplicitPoints<D, S, T, Dom>, SolverError> {
     let n = points.len();
-    let per = point_len::<D, S, T>();
+    let per = point_len::<D, S, T, Dom>();
     if flat.first() != Some(&(n as f64)) || flat.len() != 1 + n * per {
         return Err(SolverError::InvalidInput(format!(
             "the checkpoint holds {} numbers, {n} points of this scene's explicit run take {}",
@@ -838,7 +922,8 @@ fn read_points<const D: usize, S: FlatState, T: FlatState>(
         points.tau[p] = Matrix3::from_column_slice(&rest[9..18]);
         let rest = &rest[18..];
         points.material[p] = S::read(&rest[..S::LEN]);
-        points.transfer[p] = T::read(&rest[S::LEN..]);
+        points.transfer[p] = T::read(&rest[S::LEN..S::LEN + T::LEN]);
+        points.domain[p] = Dom::read(&rest[S::LEN + T::LEN..]);
     }
     Ok(points)
 }
