@@ -1849,6 +1849,30 @@ impl<const D: usize> Problem<D> {
         }
         let tolerance = check.positive(&s.tolerance, "solver `tolerance`")?;
         let max_iterations = check.at_least(&s.max_iterations, 1, "solver `max_iterations`")?;
+        let defaults = NewtonOptions::default();
+        let fraction = |value: &Option<Spanned<f64>>, default: f64, key: &str| {
+            match value {
+            None => Ok(default),
+            Some(v) if (0.0..1.0).contains(v.get_ref()) => Ok(*v.get_ref()),
+            Some(v) => Err(src.at(
+                v,
+                format!(
+                    "solver `{key}` is a fraction of the largest node's, in [0, 1) (0 disables the rule), got {}",
+                    v.get_ref()
+                ),
+            )),
+        }
+        };
+        let weak_node_threshold = fraction(
+            &s.weak_node_threshold,
+            defaults.weak_node_threshold,
+            "weak_node_threshold",
+        )?;
+        let weak_node_stiffness = fraction(
+            &s.weak_node_stiffness,
+            defaults.weak_node_stiffness,
+            "weak_node_stiffness",
+        )?;
         let linear = {
             let mut iterative = mpm_solver::IterativeOptions::default();
             if let Some(t) = &s.linear_tolerance {
@@ -2074,6 +2098,8 @@ impl<const D: usize> Problem<D> {
                 predictor: *s.predictor.get_ref(),
                 first_tangent: (*s.first_tangent.get_ref()).into(),
                 linear,
+                weak_node_threshold,
+                weak_node_stiffness,
                 ..NewtonOptions::default()
             },
             variant,
@@ -2797,6 +2823,8 @@ fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>
             "max_direct_dofs",
             s.max_direct_dofs.as_ref().map(Spanned::span),
         ),
+        ("weak_node_threshold", span(&s.weak_node_threshold)),
+        ("weak_node_stiffness", span(&s.weak_node_stiffness)),
     ];
     if let Some((key, Some(at))) = implicit_keys.into_iter().find(|(_, at)| at.is_some()) {
         return Err(src.error(

@@ -577,6 +577,18 @@ pub struct SolverSpec {
     /// [`mpm_solver::DEFAULT_MAX_DIRECT_DOFS_2D`] in 2D).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_direct_dofs: Option<Spanned<usize>>,
+    /// Implicit: nodes whose support volume and stiffness weight are both
+    /// below this fraction of the largest are held over a step
+    /// ([`mpm_solver::NewtonOptions::weak_node_threshold`]; default 1e-6,
+    /// 0 disables).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weak_node_threshold: Option<Spanned<f64>>,
+    /// Implicit: nodes whose stiffness weight is below this fraction of the
+    /// largest are held over a step
+    /// ([`mpm_solver::NewtonOptions::weak_node_stiffness`]; default 1e-4,
+    /// 0 disables).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weak_node_stiffness: Option<Spanned<f64>>,
     /// Explicit: the simulated time the run ends at (s).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub end_time: Option<Spanned<f64>>,
@@ -683,6 +695,8 @@ impl Default for SolverSpec {
             linear: at(LinearKind::default()),
             linear_tolerance: None,
             max_direct_dofs: None,
+            weak_node_threshold: None,
+            weak_node_stiffness: None,
             end_time: None,
             cfl: None,
             time_step: None,
