@@ -43,6 +43,20 @@ impl HistoryOutput for VonMisesHistory {
     }
 }
 
+/// Each point's domain box (in 3 components), for the snapshots; empty for
+/// bases without domains.
+pub(crate) fn domain_bounds<const D: usize, Dom: DomainBounds<D>>(
+    domains: &[Dom],
+    positions: &[SVector<f64, D>],
+) -> Vec<([f64; 3], [f64; 3])> {
+    let pad = |x: &SVector<f64, D>| std::array::from_fn(|i| if i < D { x[i] } else { 0.0 });
+    domains
+        .iter()
+        .zip(positions)
+        .filter_map(|(d, x)| d.bounds(x).map(|(lo, hi)| (pad(&lo), pad(&hi))))
+        .collect()
+}
+
 /// The box a material point's domain covers, for output and for measuring
 /// a body by its domains (Coombs 2020 Table 7).
 pub trait DomainBounds<const D: usize> {
@@ -174,12 +188,7 @@ impl Snapshot {
                 .iter()
                 .map(HistoryOutput::equivalent_plastic_strain)
                 .collect(),
-            domain_bounds: points
-                .domain
-                .iter()
-                .zip(&points.position)
-                .filter_map(|(d, x)| d.bounds(x).map(|(lo, hi)| (pad(&lo), pad(&hi))))
-                .collect(),
+            domain_bounds: domain_bounds(&points.domain, &points.position),
             mesh_nodes: None,
             checkpoint: None,
             tangent: None,

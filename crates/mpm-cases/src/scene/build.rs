@@ -2034,11 +2034,15 @@ impl<const D: usize> Problem<D> {
                 }
             }
         }
-        // A later fixity of the same component replaces an earlier one.
-        point_fixities.reverse();
-        let mut seen = std::collections::BTreeSet::new();
-        point_fixities.retain(|&(p, c, _)| seen.insert((p, c)));
-        point_fixities.sort_by_key(|&(p, c, _)| (p, c));
+        // Sorted by point and component, a later fixity of the same
+        // component replacing an earlier one: the rule of the solver's
+        // nodal fixities, whose list serves points as well.
+        let mut sorted = mpm_solver::VelocityFixities::new();
+        for &(p, c, v) in &point_fixities {
+            sorted.prescribe([p], c, v);
+        }
+        sorted.finish();
+        let point_fixities = sorted.entries().to_vec();
         // A held point starts at its held velocity.
         for &(p, c, v) in &point_fixities {
             initial_velocity[p][c] = v;

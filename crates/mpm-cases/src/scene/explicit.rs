@@ -747,12 +747,7 @@ fn snapshot_of<const D: usize, S: FlatState, T: FlatState, Dom: DomainBounds<D>>
             .iter()
             .map(FlatState::plastic_strain)
             .collect(),
-        domain_bounds: points
-            .domain
-            .iter()
-            .zip(&points.position)
-            .filter_map(|(d, x)| d.bounds(x).map(|(lo, hi)| (pad(&lo), pad(&hi))))
-            .collect(),
+        domain_bounds: crate::run::domain_bounds(&points.domain, &points.position),
         ..Snapshot::default()
     }
 }
