@@ -799,12 +799,11 @@ fn a_soft_and_a_stiff_body_step_with_their_own_wave_speeds() {
 /// by a rule of the point's own deformation (Coombs et al. 2020 eq. 34,
 /// U_ii l⁰): a block stretching and turning at once (v = L x with L a
 /// stretch rate plus a spin) keeps l_i = U_ii(F) l⁰_i at every point to
-/// rounding, its volumes follow det F, and the rule that would convect
-/// corners with the grid (eq. 37) is refused with a typed error naming it.
+/// rounding, its volumes follow det F, and too few domains are refused.
 #[test]
 fn gimp_domains_follow_each_points_deformation() {
     use mpm_basis::{BasisFunction, Gimp};
-    use mpm_solver::{CornerMidpoint, StretchU};
+    use mpm_solver::StretchU;
     let run = |steps: usize| {
         let h = 0.25;
         let grid = RegularGrid::new(Vector2::zeros(), Vector2::new(h, h), [32, 32]).unwrap();
@@ -861,18 +860,6 @@ fn gimp_domains_follow_each_points_deformation() {
     );
     assert!(moved > 0.01, "the block deformed: {moved}");
     assert!(worst < 1e-12, "{worst}");
-    // A rule that convects corners with the grid is refused at its first
-    // step, naming itself and the point.
-    let (solver, mut points, _) = run(1);
-    let mut solver = solver.with_domain_update(CornerMidpoint);
-    match solver.step(&mut points, 1.0) {
-        Err(SolverError::ExplicitPoint {
-            point: 0,
-            reason: PointFailure::Domain { rule, .. },
-            ..
-        }) => assert_eq!(rule, "corner_midpoint"),
-        other => panic!("{other:?}"),
-    }
     // Too few domains.
     let (solver, mut points, _) = run(1);
     let mut solver = solver.with_domain_update(StretchU);
@@ -886,56 +873,261 @@ fn gimp_domains_follow_each_points_deformation() {
 /// GIMP's bar converges at second order in h like standard MPM's, and GIMP
 /// releases the dynamic collapse that standard MPM cannot (a free-edge
 /// point inverts within 30 steps: the small-mass instability of C⁰
-/// functions, `docs/src/theory/explicit.md`).
+/// functions, `docs/src/theory/explicit.md`). So do GIMP with the midpoint
+/// rule (eq. 37, mid-points from the corners convected with the grid) and
+/// CPDI2 with its convected corners.
 ///
-/// Measured (FLIP, CFL 0.02, one period): GIMP with eq. 34 2.98e-2,
-/// 7.95e-3, 2.21e-3 on 10, 20, 40 cells (rates 1.91, 1.85; standard MPM
-/// 2.18e-3 on 40). Collapse, PIC, h = 1 m, t = 10 s: GIMP extent 14.70 m,
-/// height 5.68 m, 92 J left; the B-spline 13.30 m, 6.01 m (h = 1 m) and
-/// 15.32 m, 5.54 m (h = 0.5 m); quasi-static (Coombs et al. 2020 Table 6)
-/// 13.669 m, 6.242 m.
+/// Measured (FLIP, CFL 0.02, one period, 10, 20, 40 cells): GIMP with
+/// eq. 34 2.98e-2, 7.95e-3, 2.21e-3 (rates 1.91, 1.85); with eq. 37
+/// 2.98e-2, 7.95e-3, 2.21e-3; CPDI2 2.97e-2, 7.86e-3, 2.18e-3; standard
+/// MPM 2.18e-3 on 40. Collapse, PIC, h = 1 m, t = 10 s (extent, height,
+/// kinetic energy left): GIMP with eq. 34 14.70 m, 5.68 m, 92 J; with
+/// eq. 37 14.68 m, 5.69 m, 107 J; CPDI2 14.29 m, 5.80 m, 57 J; the
+/// B-spline 13.30 m, 6.01 m (h = 1 m) and 15.32 m, 5.54 m (h = 0.5 m);
+/// quasi-static (Coombs et al. 2020 Table 6) 13.669 m, 6.242 m.
 #[test]
-fn gimp_converges_on_the_bar_and_releases_the_collapse() {
-    use mpm_basis::Gimp;
-    use mpm_solver::StretchU;
+fn gimp_and_cpdi2_converge_on_the_bar_and_release_the_collapse() {
+    use mpm_basis::{Cpdi2, Gimp};
     use mpm_solver::explicit::verification::{dynamic_collapse_with, vibrating_bar_with};
+    use mpm_solver::{ConvectedCorners, CornerMidpoint, StretchU};
     let cells = [10, 20, 40];
-    let errors: Vec<f64> = cells
-        .iter()
-        .map(|&c| {
-            vibrating_bar_with(Gimp, StretchU, Flip, c, 0.02, 1.0, 1e-4)
-                .unwrap()
-                .error
-        })
-        .collect();
-    let rates: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
     let linear = vibrating_bar(LinearMpm, Flip, 40, 0.02, 1.0, 1e-4)
         .unwrap()
         .error;
-    eprintln!("GIMP bar errors {errors:?}, rates {rates:?}; linear at 40 cells {linear}");
-    assert!(rates.iter().all(|&r| r > 1.6), "{rates:?}");
-    assert!(errors[2] < 2.0 * linear, "{} against {linear}", errors[2]);
+    let check = |name: &str, errors: Vec<f64>| {
+        let rates: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+        eprintln!("{name} bar errors {errors:?}, rates {rates:?}; linear at 40 cells {linear}");
+        assert!(rates.iter().all(|&r| r > 1.6), "{name}: {rates:?}");
+        assert!(
+            errors[2] < 2.0 * linear,
+            "{name}: {} against {linear}",
+            errors[2]
+        );
+    };
+    let bar = |c| vibrating_bar_with(Gimp, StretchU, Flip, c, 0.02, 1.0, 1e-4);
+    check(
+        "GIMP, eq. 34",
+        cells.iter().map(|&c| bar(c).unwrap().error).collect(),
+    );
+    let bar = |c| vibrating_bar_with(Gimp, CornerMidpoint, Flip, c, 0.02, 1.0, 1e-4);
+    check(
+        "GIMP, eq. 37",
+        cells.iter().map(|&c| bar(c).unwrap().error).collect(),
+    );
+    let bar = |c| vibrating_bar_with(Cpdi2, ConvectedCorners, Flip, c, 0.02, 1.0, 1e-4);
+    check(
+        "CPDI2",
+        cells.iter().map(|&c| bar(c).unwrap().error).collect(),
+    );
 
     let linear = dynamic_collapse(LinearMpm, 1.0, 0.0, 10.0);
     assert!(
         matches!(linear, Err(SolverError::ExplicitPoint { .. })),
         "{linear:?}"
     );
-    let (extent, height, kinetic) = dynamic_collapse_with(Gimp, StretchU, 1.0, 0.0, 10.0).unwrap();
-    eprintln!("GIMP collapse, PIC: extent {extent}, height {height}, kinetic {kinetic}");
-    // At rest: under 1e-3 of the potential energy released (of order 6e5 J).
-    assert!(kinetic < 600.0, "PIC brings the block to rest: {kinetic} J");
     // The dynamic run-out depends on h (the B-spline's on 1 m and 0.5 m
-    // cells differ by 15 %); GIMP's lies within that spread.
+    // cells differ by 15 %); GIMP's and CPDI2's lie within that spread.
     let (e1, h1, _) = dynamic_collapse(QuadraticBSpline, 1.0, 0.0, 10.0).unwrap();
     let (e2, h2, _) = dynamic_collapse(QuadraticBSpline, 0.5, 0.0, 10.0).unwrap();
     eprintln!("B-spline, PIC: h = 1: {e1}, {h1}; h = 0.5: {e2}, {h2}");
-    assert!(
-        extent > e1.min(e2) && extent < e1.max(e2),
-        "extent {extent}"
+    let check = |name: &str, (extent, height, kinetic): (f64, f64, f64)| {
+        eprintln!("{name} collapse, PIC: extent {extent}, height {height}, kinetic {kinetic}");
+        // At rest: under 1e-3 of the potential energy released (of order 6e5 J).
+        assert!(
+            kinetic < 600.0,
+            "{name}: PIC brings the block to rest: {kinetic} J"
+        );
+        assert!(
+            extent > e1.min(e2) && extent < e1.max(e2),
+            "{name}: extent {extent}"
+        );
+        assert!(
+            height > h1.min(h2) && height < h1.max(h2),
+            "{name}: height {height}"
+        );
+    };
+    check(
+        "GIMP, eq. 34",
+        dynamic_collapse_with(Gimp, StretchU, 1.0, 0.0, 10.0).unwrap(),
+    );
+    check(
+        "GIMP, eq. 37",
+        dynamic_collapse_with(Gimp, CornerMidpoint, 1.0, 0.0, 10.0).unwrap(),
+    );
+    check(
+        "CPDI2",
+        dynamic_collapse_with(Cpdi2, ConvectedCorners, 1.0, 0.0, 10.0).unwrap(),
+    );
+}
+
+/// The rules that convect corners or mid-points with the grid read its
+/// displacement over the step, ½Δt Σ N_v (vⁿ_v + ṽⁿ⁺¹_v), the one the
+/// points move by. On an elastic block stretching and turning at once
+/// (v = L x at the start):
+///
+/// - CPDI2 ([`ConvectedCorners`]): after one step from rectangles, every
+///   point has moved by the mean of its four corners' displacements to
+///   rounding (a rectangle's CPDI2 corner weights are ¼ each: the point
+///   and its domain move together). Over a turn of about 80°, each
+///   interior domain's own deformation gradient (its corner map's at the
+///   centre against the rectangle's) stays the point's F, and its area
+///   det F V⁰, up to a mismatch that is first order in Δt (F follows
+///   ṽⁿ⁺¹ by eq. 39, the corners ½(vⁿ + ṽⁿ⁺¹)): halving the CFL factor
+///   halves it;
+/// - the midpoint rule of eq. 37 ([`CornerMidpoint`]): the half-lengths'
+///   product is det F times the initial one to rounding (its volume
+///   correction), and each half-length follows U_ii l⁰_i to first order
+///   in Δt likewise.
+#[test]
+fn convected_domains_follow_the_grid() {
+    use mpm_basis::{BasisFunction, Corners, Cpdi2, Gimp};
+    use mpm_solver::domain::DomainUpdater;
+    use mpm_solver::{ConvectedCorners, CornerMidpoint};
+    type Points<Dom> = ExplicitPoints<
+        2,
+        <NeoHookean as mpm_constitutive::IncrementalLaw>::State,
+        <Flip as Transfer<2>>::PointState,
+        Dom,
+    >;
+    fn run<B, R>(basis: B, rule: R, cfl: f64, end: f64, spin: f64) -> Points<B::Domain>
+    where
+        B: BasisFunction<2, Mesh = RegularGrid<2>>,
+        R: DomainUpdater<2, B::Domain>,
+    {
+        let h = 0.25;
+        let grid = RegularGrid::new(Vector2::zeros(), Vector2::new(h, h), [32, 32]).unwrap();
+        let (x0, vol) = block(Vector2::new(3.0, 3.0), Vector2::new(5.0, 5.0), h, 2);
+        let domains = x0
+            .iter()
+            .map(|x| B::initial_domain(x, &Vector2::new(h / 4.0, h / 4.0)))
+            .collect();
+        let points: PointsFor<2, NeoHookean, Flip> = ExplicitPoints::new(x0, vol, 1.0).unwrap();
+        let mut points = points.with_domains(domains).unwrap();
+        let centre = Vector2::new(4.0, 4.0);
+        let l = nalgebra::Matrix2::new(0.05, -spin, spin, -0.02);
+        points.set_velocity(|x| l * (x - centre));
+        let options = ExplicitOptions {
+            time_step: TimeStep::Cfl { factor: cfl },
+            ..Default::default()
+        };
+        let mut solver = ExplicitSolver::new(
+            basis,
+            grid,
+            NeoHookean::new(1.0, 0.3).unwrap(),
+            Flip,
+            NoLocking,
+            VelocityFixities::new(),
+            options,
+        )
+        .unwrap()
+        .with_domain_update(rule);
+        solver
+            .run_until(&mut points, end, |_, _, _| Ok(()))
+            .unwrap();
+        points
+    }
+    let upper = |f: &nalgebra::Matrix3<f64>| {
+        nalgebra::Matrix2::new(f[(0, 0)], f[(0, 1)], f[(1, 0)], f[(1, 1)])
+    };
+
+    // CPDI2, one step: the point moves with the mean of its corners.
+    let start = run(Cpdi2, ConvectedCorners, 0.3, 0.0, 0.2);
+    let points = run(Cpdi2, ConvectedCorners, 0.3, 0.05, 0.2);
+    let (mut worst, mut moved): (f64, f64) = (0.0, 0.0);
+    for p in 0..points.len() {
+        let mean = start.domain[p]
+            .as_slice()
+            .iter()
+            .zip(points.domain[p].as_slice())
+            .map(|(a, b)| b - a)
+            .sum::<Vector2<f64>>()
+            / 4.0;
+        let dx = points.position[p] - start.position[p];
+        worst = worst.max((dx - mean).norm());
+        moved = moved.max(dx.norm());
+    }
+    eprintln!(
+        "CPDI2, t = 0.05: points moved up to {moved:e}, off their corners' mean by {worst:e}"
+    );
+    assert!(moved > 1e-3, "{moved}");
+    assert!(worst < 1e-14, "{worst}");
+
+    // CPDI2 over t = 10 (a turn of about 80°): the mismatch between the
+    // corners and F's image of the rectangle, and between the area and
+    // det F V0, at two CFL factors.
+    let cpdi2 = |points: &Points<Corners<2>>| {
+        let (mut shape, mut area, mut turned): (f64, f64, f64) = (0.0, 0.0, 0.0);
+        for p in 0..points.len() {
+            let x0 = points.domain0[p].centroid().unwrap();
+            if (x0 - Vector2::new(4.0, 4.0)).amax() > 0.6 {
+                continue;
+            }
+            let f = upper(&points.f[p]);
+            // The domain's own deformation gradient at its centre (the
+            // mean over the domain of a bilinear map's).
+            let centre = Vector2::zeros();
+            let j0 = points.domain0[p].jacobian_at(&centre);
+            let f_domain = points.domain[p].jacobian_at(&centre) * j0.try_inverse().unwrap();
+            shape = shape.max((f_domain - f).norm() / f.norm());
+            let v = points.domain[p].volume().unwrap();
+            area = area.max((v / (f.determinant() * points.volume0[p]) - 1.0).abs());
+            turned = turned.max((f[(1, 0)] - f[(0, 1)]).abs());
+        }
+        (shape, area, turned)
+    };
+    let coarse = cpdi2(&run(Cpdi2, ConvectedCorners, 0.3, 10.0, 0.2));
+    let fine = cpdi2(&run(Cpdi2, ConvectedCorners, 0.15, 10.0, 0.2));
+    let finer = cpdi2(&run(Cpdi2, ConvectedCorners, 0.075, 10.0, 0.2));
+    eprintln!(
+        "CPDI2, t = 10, CFL 0.3 / 0.15 / 0.075: interior points turned by {:.3} / {:.3} / {:.3}; the domain's gradient against F {:.3e} / {:.3e} / {:.3e}; area against det F V0 {:.3e} / {:.3e} / {:.3e}",
+        coarse.2, fine.2, finer.2, coarse.0, fine.0, finer.0, coarse.1, fine.1, finer.1
+    );
+    assert!(finer.2 > 1.5, "turned {finer:?}");
+    for (name, c, f, ff) in [
+        ("gradient", coarse.0, fine.0, finer.0),
+        ("area", coarse.1, fine.1, finer.1),
+    ] {
+        // First order: each halving roughly halves the mismatch.
+        let rates = [(c / f).log2(), (f / ff).log2()];
+        assert!(
+            rates.iter().all(|r| (0.75..1.25).contains(r)),
+            "{name}: {rates:?}"
+        );
+    }
+
+    // The midpoint rule: eq. 37's volume correction exactly, turning or
+    // not; without the spin, the half-lengths follow the stretch U_ii l0_i
+    // of the interior points.
+    let midpoint = |points: &Points<Vector2<f64>>| {
+        let (mut product, mut stretch, mut moved): (f64, f64, f64) = (0.0, 0.0, 0.0);
+        for p in 0..points.len() {
+            let f = points.f[p];
+            let (l, l0) = (points.domain[p], points.domain0[p]);
+            product = product.max(((l[0] * l[1]) / (f.determinant() * l0[0] * l0[1]) - 1.0).abs());
+            if (points.position[p] - Vector2::new(4.0, 4.0)).amax() > 0.6 {
+                continue;
+            }
+            let c = (f.transpose() * f).symmetric_eigen();
+            let u = c.eigenvectors
+                * nalgebra::Matrix3::from_diagonal(&c.eigenvalues.map(f64::sqrt))
+                * c.eigenvectors.transpose();
+            for i in 0..2 {
+                stretch = stretch.max((l[i] - u[(i, i)] * l0[i]).abs() / l0[i]);
+                moved = moved.max((u[(i, i)] - 1.0).abs());
+            }
+        }
+        (product, stretch, moved)
+    };
+    let turning = midpoint(&run(Gimp, CornerMidpoint, 0.3, 10.0, 0.2));
+    let stretching = midpoint(&run(Gimp, CornerMidpoint, 0.3, 1.0, 0.0));
+    eprintln!(
+        "midpoint rule: half-lengths times det F against the initial ones {:.1e} turning (t = 10), {:.1e} stretching (t = 1); stretching, interior U_ii moved by up to {:.3}, the half-lengths off U_ii l0 by {:.3e}",
+        turning.0, stretching.0, stretching.2, stretching.1
     );
     assert!(
-        height > h1.min(h2) && height < h1.max(h2),
-        "height {height}"
+        turning.0 < 1e-12 && stretching.0 < 1e-12,
+        "{turning:?} {stretching:?}"
     );
+    assert!(stretching.2 > 0.03, "{stretching:?}");
+    assert!(stretching.1 < 0.05 * stretching.2, "{stretching:?}");
 }

@@ -6,7 +6,9 @@ use mpm_constitutive::IncrementalLaw;
 use nalgebra::{Matrix3, SMatrix, SVector};
 
 use super::grid_update::GridState;
+use crate::domain::DomainError;
 use crate::error::PointFailure;
+use crate::mesh::NodalMesh;
 
 /// The grid fields interpolated at a point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,6 +66,60 @@ pub fn move_point<const D: usize>(
 ) {
     *x += (g.new_velocity + g.old_velocity) * (0.5 * dt);
     *v = super::transfer::blend_velocity(alpha, v, &g.new_velocity, &g.old_velocity);
+}
+
+/// The largest linear shape function value of a node without mass that
+/// [`grid_displacement`] takes for rounding: a point $10^{-10}$ cell
+/// widths across a cell face (the GIMP collapse puts mid-points on the
+/// symmetry edge at $x = -8\cdot 10^{-17}$).
+pub const ROUNDING_WEIGHT: f64 = 1e-10;
+
+/// The grid's displacement over the step at a point `x` of the
+/// configuration at the step's start, interpolated with the mesh's own
+/// linear shape functions $N_v$:
+/// $$\Delta\mathbf u(\mathbf x) = \tfrac{\Delta t}2\sum_v N_v(\mathbf x)
+/// \left(v^n_v + \tilde v^{n+1}_v\right),$$
+/// the nodal displacement that [`move_point`] gives the points. It is the
+/// explicit counterpart of the converged displacement increment of
+/// Coombs et al. 2020 eq. (35), which the rules that convect corners or
+/// mid-points read (CPDI2's [`crate::ConvectedCorners`], the midpoint rules
+/// of eq. 37). For CPDI2 it keeps the point and its corners together: the
+/// point's weights are the corner-weighted sums of the $N_v$ at the
+/// corners, so the point moves by the corner-weighted mean of the corners'
+/// displacements.
+///
+/// A corner or mid-point on a face of the material's cells reads no node
+/// beyond the face, but rounding can put it a hair across, where the
+/// nodes beyond have no mass: weights up to [`ROUNDING_WEIGHT`] on such
+/// nodes are taken as zero.
+///
+/// # Errors
+/// `x` outside the mesh; a node with a larger $N_v(\mathbf x)$ and no
+/// mass this step (its velocity is not defined).
+pub fn grid_displacement<const D: usize, M: NodalMesh<D>>(
+    mesh: &M,
+    grid: &GridState<D>,
+    dt: f64,
+    x: &SVector<f64, D>,
+    stencil: &mut mpm_basis::Stencil<D>,
+) -> Result<SVector<f64, D>, DomainError> {
+    let at = || x.as_slice().to_vec();
+    mesh.shape_functions(x, stencil)
+        .map_err(|source| DomainError::Mesh { at: at(), source })?;
+    let mut sum = SVector::<f64, D>::zeros();
+    for (&node, &value) in stencil.nodes.iter().zip(&stencil.values) {
+        // Entries outside lo..hi are stale; a node without mass has none.
+        let active = node >= grid.lo && node < grid.hi && grid.mass[node] > 0.0;
+        if !active {
+            if value.abs() <= ROUNDING_WEIGHT {
+                continue;
+            }
+            return Err(DomainError::InactiveNode { node, at: at() });
+        }
+        let v = &grid.velocity[node];
+        sum += (v.old + v.new) * value;
+    }
+    Ok(sum * (0.5 * dt))
 }
 
 /// $\mathbf 1 + \Delta t\,\nabla v$ embedded in 3×3 (plane strain: the

@@ -56,9 +56,10 @@ pub use p2g::GridBuffer;
 pub use points::ExplicitPoints;
 pub use transfer::{Flip, FlipPic, Pic, Taylor, Transfer, VelocityGradient};
 
-use crate::domain::{DomainContext, DomainError, DomainUpdater, NoUpdate};
+use crate::domain::{DomainContext, DomainUpdater, NoUpdate};
 use crate::error::{PointFailure, SolverError};
 use crate::locking::NoLocking;
+use crate::mesh::NodalMesh;
 
 /// Points of one grid-to-point task per thread, times this.
 const TASKS_PER_THREAD: usize = 4;
@@ -126,11 +127,20 @@ pub struct StepInfo {
 /// basis with a domain per point ([`NoUpdate`] unless
 /// [`ExplicitSolver::with_domain_update`] names one). After every step
 /// each point's domain is updated from its new deformation gradient and
-/// the step's increment $\Delta F = I + \Delta t\,\nabla v$ (eq. 39):
-/// GIMP with the rules of the point's own deformation (Coombs et al. 2020
-/// eqs. 32–34, 38, 39). Rules that convect corners or mid-points with the
-/// grid (eq. 37, CPDI2) are refused at the first step with a typed error:
-/// the explicit solver does not interpolate a grid displacement at them.
+/// the step's increment $\Delta F = I + \Delta t\,\nabla v$ (eq. 39), or
+/// from the grid's displacement over the step at its corners or
+/// mid-points ([`g2p::grid_displacement`]): GIMP with every rule of
+/// Coombs et al. 2020 §6.4 (eqs. 32–39), CPDI2 with
+/// [`crate::ConvectedCorners`].
+///
+/// **Volumes.** A point's volume is $\det F\,V^0_p$ (eq. 40) for every
+/// basis, CPDI2 included: the internal force is $V^0_p\tau_p\nabla w$
+/// (eq. 20 in Kirchhoff form) and the stored energy $V^0_p\psi(F_p)$, so
+/// the work–energy balance holds only with that volume. CPDI2's convected
+/// domain has a volume of its own ([`DomainUpdater::volume`], which the
+/// implicit solver uses); it follows $\det F\,V^0_p$ to first order in
+/// $\Delta t$ per step, and the explicit solver leaves it a property of the
+/// domain (measured in `tests/explicit.rs`).
 pub struct ExplicitSolver<const D: usize, B, L, T, K = NoLocking, R = NoUpdate>
 where
     B: BasisFunction<D>,
@@ -245,7 +255,7 @@ where
 impl<const D: usize, B, L, T, K, R> ExplicitSolver<D, B, L, T, K, R>
 where
     B: BasisFunction<D>,
-    B::Mesh: ExplicitMesh<D>,
+    B::Mesh: ExplicitMesh<D> + NodalMesh<D>,
     L: IncrementalLaw,
     T: Transfer<D>,
     K: DilatationTreatment,
@@ -254,8 +264,9 @@ where
     /// Whether the basis has a domain per point (`Domain` is not `()`).
     const HAS_DOMAIN: bool = std::mem::size_of::<B::Domain>() > 0;
 
-    /// The same solver with the domain update `rule` (GIMP: one of the
-    /// rules of the point's own deformation, e.g. [`crate::StretchU`]).
+    /// The same solver with the domain update `rule` (GIMP: e.g.
+    /// [`crate::StretchU`] or [`crate::CornerMidpoint`]; CPDI2:
+    /// [`crate::ConvectedCorners`]).
     pub fn with_domain_update<R2: DomainUpdater<D, B::Domain>>(
         self,
         rule: R2,
@@ -637,6 +648,7 @@ where
             .map(
                 |(task, (x, v, f, vol, tau, mat, tr, mass, vol0, dom, dom0))| {
                     let mut stencil = basis.new_stencil();
+                    let field = DomainField::new(mesh, grid, dt);
                     let mut signal: f64 = 0.0;
                     for k in 0..x.len() {
                         let point = task * per + k;
@@ -664,7 +676,7 @@ where
                         if Self::HAS_DOMAIN {
                             update_domain::<D, B, R>(
                                 rule,
-                                dt,
+                                &field,
                                 &g.grad,
                                 &f[k],
                                 &x_start,
@@ -739,6 +751,7 @@ where
             }
         }
         let (law, sums, cells) = (&self.law, &self.cell_sums, &self.cell_scratch);
+        let (mesh, grid) = (&self.mesh, &self.grid);
         let (rule, starts) = (&self.domain_rule, &self.position_scratch);
         let p = points;
         let results: Vec<Result<f64, (usize, PointFailure)>> = (
@@ -764,6 +777,7 @@ where
             .enumerate()
             .map(
                 |(task, ((f, vol, tau, mat, tr, grads), (cells, v, mass, vol0, dom, dom0, x)))| {
+                    let field = DomainField::new(mesh, grid, dt);
                     let mut signal: f64 = 0.0;
                     for k in 0..f.len() {
                         let point = task * per + k;
@@ -796,7 +810,7 @@ where
                         if Self::HAS_DOMAIN {
                             update_domain::<D, B, R>(
                                 rule,
-                                dt,
+                                &field,
                                 grad,
                                 &f[k],
                                 &starts[point],
@@ -819,22 +833,27 @@ where
 /// A point's domain after its step (the explicit counterpart of the
 /// implicit solver's update after a converged load step): the rule sees
 /// the new $F$, the step's $\Delta F = I + \Delta t\,\nabla v$ (eq. 39,
-/// the unmodified gradient, as $F$ follows it) and the positions before
-/// and after. Rules that read the grid displacement at corners or
-/// mid-points get an error from it.
+/// the unmodified gradient, as $F$ follows it), the positions before and
+/// after, and for rules that convect corners or mid-points the grid's
+/// displacement over the step ([`g2p::grid_displacement`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn update_domain<const D: usize, B: BasisFunction<D>, R: DomainUpdater<D, B::Domain>>(
+fn update_domain<const D: usize, B, R>(
     rule: &R,
-    dt: f64,
+    field: &DomainField<'_, D, B::Mesh>,
     grad: &SMatrix<f64, D, D>,
     f: &nalgebra::Matrix3<f64>,
     position_previous: &SVector<f64, D>,
     position: &SVector<f64, D>,
     initial: &B::Domain,
     domain: &mut B::Domain,
-) -> Result<(), PointFailure> {
-    let delta_f = g2p::increment(dt, grad);
+) -> Result<(), PointFailure>
+where
+    B: BasisFunction<D>,
+    B::Mesh: NodalMesh<D>,
+    R: DomainUpdater<D, B::Domain>,
+{
+    let delta_f = g2p::increment(field.dt, grad);
     let ctx = DomainContext {
         initial,
         previous: domain,
@@ -843,23 +862,43 @@ fn update_domain<const D: usize, B: BasisFunction<D>, R: DomainUpdater<D, B::Dom
         position_previous,
         position,
     };
-    let no_field = |x: &SVector<f64, D>| {
-        Err(DomainError::Inadmissible {
-            rule: R::NAME,
-            reason: format!(
-                "it reads the grid displacement at {:?}, which the explicit solver does not interpolate; use a rule of the point's own deformation (none, det_f, diag_f, stretch, volume_corrected_diag_f, incremental_volume_corrected_diag_f)",
-                x.as_slice()
-            ),
-        })
-    };
     let updated = rule
-        .update(&ctx, no_field)
+        .update(&ctx, |x: &SVector<f64, D>| {
+            g2p::grid_displacement(
+                field.mesh,
+                field.grid,
+                field.dt,
+                x,
+                &mut field.stencil.borrow_mut(),
+            )
+        })
         .map_err(|source| PointFailure::Domain {
             rule: R::NAME,
             source: Box::new(source),
         })?;
     *domain = updated;
     Ok(())
+}
+
+/// What a domain update reads of the grid: one per grid-to-point task.
+struct DomainField<'a, const D: usize, M> {
+    mesh: &'a M,
+    grid: &'a GridState<D>,
+    dt: f64,
+    stencil: std::cell::RefCell<mpm_basis::Stencil<D>>,
+}
+
+impl<'a, const D: usize, M> DomainField<'a, D, M> {
+    /// The stencil grows on first use only (rules of the point's own
+    /// deformation never read the grid).
+    fn new(mesh: &'a M, grid: &'a GridState<D>, dt: f64) -> Self {
+        Self {
+            mesh,
+            grid,
+            dt,
+            stencil: std::cell::RefCell::new(mpm_basis::Stencil::default()),
+        }
+    }
 }
 
 /// Points per grid-to-point task.
