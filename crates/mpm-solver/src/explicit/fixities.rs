@@ -9,6 +9,9 @@ pub struct VelocityFixities {
     /// (node, component, velocity), in the order given until
     /// [`VelocityFixities::finish`] sorts them and drops repeats.
     entries: Vec<(usize, usize, f64)>,
+    /// Bit `c` of entry `n`: component `c` of node `n` is held (built by
+    /// [`VelocityFixities::finish`]).
+    mask: Vec<u8>,
 }
 
 impl VelocityFixities {
@@ -49,6 +52,32 @@ impl VelocityFixities {
             }
         }
         self.entries = out;
+        self.mask.clear();
+        if let Some(&(last, _, _)) = self.entries.last() {
+            self.mask.resize(last + 1, 0);
+        }
+        for &(n, c, _) in &self.entries {
+            // Components beyond the mask's bits (D > 8) are caught by the
+            // solver's check of c < D.
+            if c < 8 {
+                self.mask[n] |= 1 << c;
+            }
+        }
+    }
+
+    /// The prescribed velocity of component `component` of `node`, if it is
+    /// held (after [`VelocityFixities::finish`]; `None` before). A bit test
+    /// for a node without fixities, a binary search otherwise.
+    #[inline]
+    pub fn held(&self, node: usize, component: usize) -> Option<f64> {
+        let bit = self.mask.get(node).copied().unwrap_or(0) >> component.min(7);
+        if component >= 8 || bit & 1 == 0 {
+            return None;
+        }
+        self.entries
+            .binary_search_by_key(&(node, component), |&(n, c, _)| (n, c))
+            .ok()
+            .map(|i| self.entries[i].2)
     }
 
     /// The fixed components: sorted by node and component after
@@ -78,5 +107,11 @@ mod tests {
         f.fix([3, 1], 0).prescribe([3], 0, 2.0).fix([3], 1);
         f.finish();
         assert_eq!(f.entries(), &[(1, 0, 0.0), (3, 0, 2.0), (3, 1, 0.0)]);
+        assert_eq!(f.held(3, 0), Some(2.0));
+        assert_eq!(f.held(3, 1), Some(0.0));
+        assert_eq!(f.held(1, 0), Some(0.0));
+        for (n, c) in [(1, 1), (0, 0), (2, 0), (3, 2), (4, 0), (3, 9)] {
+            assert_eq!(f.held(n, c), None, "({n}, {c})");
+        }
     }
 }

@@ -77,16 +77,25 @@ pub const ROUNDING_WEIGHT: f64 = 1e-10;
 /// The grid's displacement over the step at a point `x` of the
 /// configuration at the step's start, interpolated with the mesh's own
 /// linear shape functions $N_v$:
-/// $$\Delta\mathbf u(\mathbf x) = \tfrac{\Delta t}2\sum_v N_v(\mathbf x)
-/// \left(v^n_v + \tilde v^{n+1}_v\right),$$
-/// the nodal displacement that [`move_point`] gives the points. It is the
-/// explicit counterpart of the converged displacement increment of
+/// $$\Delta\mathbf u(\mathbf x) = \sum_v N_v(\mathbf x)\,\Delta\mathbf u_v,\qquad
+/// \Delta\mathbf u_v = \tfrac{\Delta t}2\left(v^n_v + \tilde v^{n+1}_v\right),$$
+/// the nodal displacement that [`move_point`] gives the points, except
+/// that a held component moves with its prescribed velocity,
+/// $\Delta u_{v,i} = \Delta t\,v^{fix}_{v,i}$: the node's own path. It is
+/// the explicit counterpart of the converged displacement increment of
 /// Coombs et al. 2020 eq. (35), which the rules that convect corners or
 /// mid-points read (CPDI2's [`crate::ConvectedCorners`], the midpoint rules
-/// of eq. 37). For CPDI2 it keeps the point and its corners together: the
-/// point's weights are the corner-weighted sums of the $N_v$ at the
-/// corners, so the point moves by the corner-weighted mean of the corners'
-/// displacements.
+/// of eq. 37).
+///
+/// - Away from held nodes it keeps a CPDI2 point with its corners: the
+///   point's weights are the corner-weighted sums of the $N_v$ at the
+///   corners, so the point moves by the corner-weighted mean of the
+///   corners' displacements.
+/// - On a held face a corner stays on the face. With
+///   $\tfrac12(v^n + \tilde v^{n+1})$ there, the mapped $v^n$ of a wall
+///   node (the body's velocity into the wall, or rounding) would carry a
+///   corner of a body that fills the grid up to the wall out of the grid,
+///   where CPDI2 cannot evaluate it.
 ///
 /// A corner or mid-point on a face of the material's cells reads no node
 /// beyond the face, but rounding can put it a hair across, where the
@@ -99,6 +108,7 @@ pub const ROUNDING_WEIGHT: f64 = 1e-10;
 pub fn grid_displacement<const D: usize, M: NodalMesh<D>>(
     mesh: &M,
     grid: &GridState<D>,
+    fixities: &super::VelocityFixities,
     dt: f64,
     x: &SVector<f64, D>,
     stencil: &mut mpm_basis::Stencil<D>,
@@ -117,9 +127,15 @@ pub fn grid_displacement<const D: usize, M: NodalMesh<D>>(
             return Err(DomainError::InactiveNode { node, at: at() });
         }
         let v = &grid.velocity[node];
-        sum += (v.old + v.new) * value;
+        for i in 0..D {
+            let du = match fixities.held(node, i) {
+                Some(held) => dt * held,
+                None => 0.5 * dt * (v.old[i] + v.new[i]),
+            };
+            sum[i] += value * du;
+        }
     }
-    Ok(sum * (0.5 * dt))
+    Ok(sum)
 }
 
 /// $\mathbf 1 + \Delta t\,\nabla v$ embedded in 3×3 (plane strain: the

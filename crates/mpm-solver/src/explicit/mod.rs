@@ -627,7 +627,7 @@ where
     ) -> Result<f64, (usize, PointFailure)> {
         let per = task_size(points.len());
         let (basis, mesh, grid, law) = (&self.basis, &self.mesh, &self.grid, &self.law);
-        let rule = &self.domain_rule;
+        let (rule, fixities) = (&self.domain_rule, &self.fixities);
         let alpha = self.transfer.alpha();
         let p = points;
         let results: Vec<Result<f64, (usize, PointFailure)>> = (
@@ -648,7 +648,7 @@ where
             .map(
                 |(task, (x, v, f, vol, tau, mat, tr, mass, vol0, dom, dom0))| {
                     let mut stencil = basis.new_stencil();
-                    let field = DomainField::new(mesh, grid, dt);
+                    let field = DomainField::new(mesh, grid, fixities, dt);
                     let mut signal: f64 = 0.0;
                     for k in 0..x.len() {
                         let point = task * per + k;
@@ -751,7 +751,7 @@ where
             }
         }
         let (law, sums, cells) = (&self.law, &self.cell_sums, &self.cell_scratch);
-        let (mesh, grid) = (&self.mesh, &self.grid);
+        let (mesh, grid, fixities) = (&self.mesh, &self.grid, &self.fixities);
         let (rule, starts) = (&self.domain_rule, &self.position_scratch);
         let p = points;
         let results: Vec<Result<f64, (usize, PointFailure)>> = (
@@ -777,7 +777,7 @@ where
             .enumerate()
             .map(
                 |(task, ((f, vol, tau, mat, tr, grads), (cells, v, mass, vol0, dom, dom0, x)))| {
-                    let field = DomainField::new(mesh, grid, dt);
+                    let field = DomainField::new(mesh, grid, fixities, dt);
                     let mut signal: f64 = 0.0;
                     for k in 0..f.len() {
                         let point = task * per + k;
@@ -867,6 +867,7 @@ where
             g2p::grid_displacement(
                 field.mesh,
                 field.grid,
+                field.fixities,
                 field.dt,
                 x,
                 &mut field.stencil.borrow_mut(),
@@ -884,6 +885,7 @@ where
 struct DomainField<'a, const D: usize, M> {
     mesh: &'a M,
     grid: &'a GridState<D>,
+    fixities: &'a VelocityFixities,
     dt: f64,
     stencil: std::cell::RefCell<mpm_basis::Stencil<D>>,
 }
@@ -891,10 +893,11 @@ struct DomainField<'a, const D: usize, M> {
 impl<'a, const D: usize, M> DomainField<'a, D, M> {
     /// The stencil grows on first use only (rules of the point's own
     /// deformation never read the grid).
-    fn new(mesh: &'a M, grid: &'a GridState<D>, dt: f64) -> Self {
+    fn new(mesh: &'a M, grid: &'a GridState<D>, fixities: &'a VelocityFixities, dt: f64) -> Self {
         Self {
             mesh,
             grid,
+            fixities,
             dt,
             stencil: std::cell::RefCell::new(mpm_basis::Stencil::default()),
         }
