@@ -566,13 +566,13 @@ fn malformed_scenes_are_refused_with_a_located_message() {
         ),
         (
             "steps = 2",
-            "kind = \"explicit\"\nend_time = 1.0\nbasis = \"cpdi2\"",
-            "bad.toml:29:9: basis = cpdi2 convects its corners with the grid, which the explicit solver does not do",
+            "kind = \"explicit\"\nend_time = 1.0\nbasis = \"cpdi2\"\ndomain_update = \"midpoint\"",
+            "bad.toml:30:17: basis = cpdi2 convects its corners with the grid; domain_update = midpoint applies to gimp only",
         ),
         (
             "steps = 2",
-            "kind = \"explicit\"\nend_time = 1.0\nbasis = \"gimp\"\ndomain_update = \"midpoint\"",
-            "bad.toml:30:17: domain_update = midpoint convects corners or mid-points with the grid, which the explicit solver does not do",
+            "kind = \"explicit\"\nend_time = 1.0\nbasis = \"gimp\"\ndomain_update = \"cpdi2\"",
+            "bad.toml:30:17: domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2",
         ),
         (
             "steps = 2",

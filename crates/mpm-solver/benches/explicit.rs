@@ -7,21 +7,23 @@
 //!   0.25 m, a 12 m block of 2² points per cell, Neo-Hookean, FLIP, one
 //!   thread, every timed step from the same initial state) with each
 //!   basis the explicit solver takes: standard MPM, the quadratic B-spline,
-//!   the boundary-modified spline, and GIMP without a domain update and
-//!   with eq. 34 (the cost of the domain and of its update).
+//!   the boundary-modified spline, GIMP without a domain update, with
+//!   eq. 34 and with the corner midpoint rule of eq. 37 (the cost of the
+//!   domain, of its update and of reading the grid at its corners), and
+//!   CPDI2 with its convected corners.
 //!
 //! Criterion reports time per step; particle-steps per second = points /
 //! time (printed as throughput).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use mpm_basis::{BasisFunction, BoundaryBSpline, Gimp, LinearMpm, QuadraticBSpline};
+use mpm_basis::{BasisFunction, BoundaryBSpline, Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_constitutive::NeoHookean;
 use mpm_mesh::RegularGrid;
 use mpm_solver::explicit::verification::{block, elastic_cube};
 use mpm_solver::explicit::{PointsFor, VelocityFixities};
 use mpm_solver::{
-    DomainUpdater, ExplicitOptions, ExplicitPoints, ExplicitSolver, Flip, NoLocking, NoUpdate,
-    StretchU, TimeStep,
+    ConvectedCorners, CornerMidpoint, DomainUpdater, ExplicitOptions, ExplicitPoints,
+    ExplicitSolver, Flip, NoLocking, NoUpdate, StretchU, TimeStep,
 };
 use nalgebra::Vector2;
 
@@ -118,6 +120,8 @@ fn bases(c: &mut Criterion) {
     block_step(&mut group, "bspline2_boundary", BoundaryBSpline, NoUpdate);
     block_step(&mut group, "gimp_none", Gimp, NoUpdate);
     block_step(&mut group, "gimp_stretch", Gimp, StretchU);
+    block_step(&mut group, "gimp_corner_midpoint", Gimp, CornerMidpoint);
+    block_step(&mut group, "cpdi2", Cpdi2, ConvectedCorners);
     group.finish();
 }
 

@@ -5,11 +5,14 @@
 
 use std::time::Instant;
 
-use mpm_basis::{BasisFunction, BoundaryBSpline, LinearMpm, QuadraticBSpline};
+use mpm_basis::{BasisFunction, BoundaryBSpline, Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_mesh::RegularGrid;
 use mpm_solver::explicit::Transfer;
-use mpm_solver::explicit::verification::{colliding_disks, fixed_end_bar, vibrating_bar};
-use mpm_solver::{Flip, FlipPic, Pic, SolverError, Taylor};
+use mpm_solver::explicit::verification::{colliding_disks, fixed_end_bar, vibrating_bar_with};
+use mpm_solver::{
+    ConvectedCorners, CornerMidpoint, DomainUpdater, Flip, FlipPic, NoUpdate, Pic, SolverError,
+    StretchU, Taylor,
+};
 
 use super::Mode;
 use super::study::{CaseSpec, Level, Sample, VariantSpec};
@@ -62,21 +65,26 @@ fn timed<T>(f: impl FnOnce() -> Result<T, SolverError>) -> Result<(T, f64), Stri
 }
 
 /// The free–free bar (the symmetric half of a bar of 2L) with basis `B`
-/// at `cells` cells over 2L.
-struct FreeBar<B> {
+/// and domain update `R` at `cells` cells over 2L.
+struct FreeBar<B, R> {
     basis: B,
+    rule: R,
     cells: usize,
 }
 
-impl<B> WithTransfer for FreeBar<B>
+impl<B, R> WithTransfer for FreeBar<B, R>
 where
-    B: BasisFunction<2, Domain = (), Mesh = RegularGrid<2>>,
+    B: BasisFunction<2, Mesh = RegularGrid<2>>,
+    R: DomainUpdater<2, B::Domain>,
 {
     type Output = Result<Sample, String>;
 
     fn with<T: Transfer<2>>(self, transfer: T) -> Self::Output {
-        let (bar, seconds) =
-            timed(|| vibrating_bar(self.basis, transfer, self.cells, BAR_CFL, 1.0, BAR_V0))?;
+        let (bar, seconds) = timed(|| {
+            vibrating_bar_with(
+                self.basis, self.rule, transfer, self.cells, BAR_CFL, 1.0, BAR_V0,
+            )
+        })?;
         Ok(Sample {
             error: bar.error,
             seconds,
@@ -93,10 +101,17 @@ const BAR_V0: f64 = 1e-4;
 /// Half the bar's 2L: the length L of the fixed-end bar.
 const BAR_L: f64 = 25.0;
 
-/// A free–free bar variant with `basis` and the transfer `kind`.
-fn free_bar<B>(basis_name: &str, basis: B, (name, kind): (&str, TransferKind)) -> VariantSpec
+/// A free–free bar variant with `basis`, its domain update `rule` and the
+/// transfer `kind`.
+fn free_bar<B, R>(
+    basis_name: &str,
+    basis: B,
+    rule: R,
+    (name, kind): (&str, TransferKind),
+) -> VariantSpec
 where
-    B: BasisFunction<2, Domain = (), Mesh = RegularGrid<2>> + Copy + 'static,
+    B: BasisFunction<2, Mesh = RegularGrid<2>> + Copy + 'static,
+    R: DomainUpdater<2, B::Domain> + Copy + 'static,
 {
     VariantSpec::new(
         format!("mirrored end, {basis_name}, {name}"),
@@ -105,6 +120,7 @@ where
                 kind,
                 FreeBar {
                     basis,
+                    rule,
                     cells: 2 * l.n,
                 },
             )
@@ -134,9 +150,20 @@ pub fn bar(mode: Mode) -> CaseSpec {
     };
     let mut variants = Vec::new();
     for t in transfers() {
-        variants.push(free_bar("linear", LinearMpm, t));
-        variants.push(free_bar("quadratic B-spline", QuadraticBSpline, t));
+        variants.push(free_bar("linear", LinearMpm, NoUpdate, t));
+        variants.push(free_bar(
+            "quadratic B-spline",
+            QuadraticBSpline,
+            NoUpdate,
+            t,
+        ));
     }
+    // The bases with domains, with FLIP: the transfer acts on them as on
+    // the others.
+    let flip = ("FLIP", TransferKind::Flip);
+    variants.push(free_bar("GIMP (eq. 34)", Gimp, StretchU, flip));
+    variants.push(free_bar("GIMP (eq. 37)", Gimp, CornerMidpoint, flip));
+    variants.push(free_bar("CPDI2", Cpdi2, ConvectedCorners, flip));
     variants.push(fixed_bar("linear", LinearMpm));
     variants.push(fixed_bar("quadratic B-spline", QuadraticBSpline));
     variants.push(fixed_bar("boundary B-spline", BoundaryBSpline));
@@ -158,8 +185,9 @@ pub fn bar(mode: Mode) -> CaseSpec {
              \"fixed end\": the end held by a velocity fixity (`fixed_end_bar`, FLIP only; the \
              boundary-modified B-spline is interpolatory there, the plain one fixes the end and \
              the padding node). Bases: linear, quadratic B-spline, boundary-modified B-spline \
-             (fixed end only, where it differs from the plain one). Transfers: PIC, FLIP, the \
-             blend α = 0.99, Taylor-PIC and Taylor-FLIP. Reference: u = (v₀/ω) sin ωt sin βx; \
+             (fixed end only, where it differs from the plain one), and with FLIP GIMP (half-lengths \
+             h/4, updated by eq. 34 or the corner midpoint rule of eq. 37) and CPDI2 (convected \
+             corners). Transfers: PIC, FLIP, the blend α = 0.99, Taylor-PIC and Taylor-FLIP. Reference: u = (v₀/ω) sin ωt sin βx; \
              error: the RMS of the point displacements against it at 8 instants, relative to \
              the amplitude. Levels: n cells over L, n = {} (h = {BAR_L}/n).",
             ns.iter()

@@ -2838,26 +2838,6 @@ fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>
             ),
         ));
     }
-    if let Some(b) = &s.basis
-        && *b.get_ref() == BasisKind::Cpdi2
-    {
-        return Err(src.at(
-            b,
-            "basis = cpdi2 convects its corners with the grid, which the explicit solver does not do; use basis = \"bspline2\" (the default), \"bspline2_boundary\", \"linear\" or \"gimp\"",
-        ));
-    }
-    let update = *s.domain_update.get_ref();
-    if matches!(
-        update,
-        DomainUpdateKind::CornerMidpoint | DomainUpdateKind::Midpoint | DomainUpdateKind::Cpdi2
-    ) {
-        return Err(src.at(
-            &s.domain_update,
-            format!(
-                "domain_update = {update} convects corners or mid-points with the grid, which the explicit solver does not do; it takes the rules of each point's own deformation: none, det_f, diag_f, stretch, volume_corrected_diag_f, incremental_volume_corrected_diag_f"
-            ),
-        ));
-    }
     let locking = *s.locking.get_ref();
     if matches!(locking, LockingKind::FBar | LockingKind::FPatch) {
         return Err(src.at(

@@ -6,13 +6,13 @@
 //! points, with a [`Checkpoint`] to resume from when asked for.
 //!
 //! The solvers are compiled once per dimension, here ([`RunExplicit`]):
-//! basis (`linear`, `bspline2`, `bspline2_boundary`, and `gimp` with its
-//! `domain_update` rule chosen at run time) × law (closed-form
-//! `NeoHookean`, `Spectral<HenckyElastic>`, `Spectral<VonMises>`, each
-//! alone or as a `MaterialSet` when the scene's materials differ in more
-//! than density) × transfer (`FlipPic`, which covers PIC, FLIP and their
-//! blend; `Taylor`) × dilatation (`NoLocking`, `CellAveraged`): 96
-//! solvers per dimension. A scene of one material (or of materials that
+//! basis (`linear`, `bspline2`, `bspline2_boundary`, `gimp` with its
+//! `domain_update` rule chosen at run time, and `cpdi2` with its convected
+//! corners) × law (closed-form `NeoHookean`, `Spectral<HenckyElastic>`,
+//! `Spectral<VonMises>`, each alone or as a `MaterialSet` when the scene's
+//! materials differ in more than density) × transfer (`FlipPic`, which
+//! covers PIC, FLIP and their blend; `Taylor`) × dilatation (`NoLocking`,
+//! `CellAveraged`): 120 solvers per dimension. A scene of one material (or of materials that
 //! differ in density only) runs the law alone: no tag per point, one wave
 //! modulus; a basis without domains stores none.
 //!
@@ -61,7 +61,7 @@
 
 use std::time::Instant;
 
-use mpm_basis::{BasisFunction, BoundaryBSpline, Gimp, LinearMpm, QuadraticBSpline};
+use mpm_basis::{BasisFunction, BoundaryBSpline, Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_constitutive::{
     HenckyElastic, IncrementalLaw, MaterialSet, MaterialState, NeoHookean, Spectral, Tagged,
     VonMises,
@@ -72,10 +72,10 @@ use mpm_solver::explicit::{
     VelocityGradient,
 };
 use mpm_solver::{
-    CellAveraged, DetF, DiagF, DisplacementField, DomainContext, DomainError, DomainUpdater,
-    ExplicitOptions, ExplicitPoints, ExplicitSolver, Flat, FlipPic,
-    IncrementalVolumeCorrectedDiagF, NoLocking, NoUpdate, RunState, RunSummary, SolverError,
-    StretchU, Taylor, Transfer, VolumeCorrectedDiagF,
+    CellAveraged, ConvectedCorners, CornerMidpoint, DetF, DiagF, DisplacementField, DomainContext,
+    DomainError, DomainUpdater, ExplicitOptions, ExplicitPoints, ExplicitSolver, Flat, FlipPic,
+    IncrementalVolumeCorrectedDiagF, Midpoint, NoLocking, NoUpdate, RunState, RunSummary,
+    SolverError, StretchU, Taylor, Transfer, VolumeCorrectedDiagF,
 };
 use nalgebra::{Matrix3, SVector};
 
@@ -221,10 +221,7 @@ fn dispatch<const D: usize>(
     problem: &Problem<D>,
     control: &RunControl,
     observer: &mut ExplicitObserver<'_>,
-) -> Result<ExplicitOutput, SolverError>
-where
-    SVector<f64, D>: FlatState,
-{
+) -> Result<ExplicitOutput, SolverError> {
     parts(problem)?;
     let run = Run {
         problem,
@@ -236,16 +233,15 @@ where
         BasisKind::BSpline2 => run.with_basis(QuadraticBSpline, NoUpdate),
         BasisKind::BSpline2Boundary => run.with_basis(BoundaryBSpline, NoUpdate),
         BasisKind::Gimp => run.with_basis(Gimp, GimpRule(problem.variant.domain_update)),
-        other => Err(SolverError::InvalidInput(format!(
-            "basis = {other} convects its corners with the grid, which the explicit solver does not do; it takes linear, bspline2, bspline2_boundary or gimp"
-        ))),
+        BasisKind::Cpdi2 => run.with_basis(Cpdi2, ConvectedCorners),
     }
 }
 
 /// The GIMP domain rule of the scene, chosen when the run starts (one
 /// solver for every rule rather than one per rule: a branch per point and
-/// step, beside the stress update). The builder admits the rules of the
-/// point's own deformation only.
+/// step, beside the stress update): every rule of Coombs et al. 2020
+/// §6.4, those that convect mid-points with the grid included; the
+/// builder refuses `cpdi2` with `basis = "gimp"`.
 #[derive(Debug, Clone, Copy)]
 struct GimpRule(DomainUpdateKind);
 
@@ -266,11 +262,11 @@ impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for GimpRule {
             DomainUpdateKind::IncrementalVolumeCorrectedDiagF => {
                 IncrementalVolumeCorrectedDiagF.update(ctx, field)
             }
+            DomainUpdateKind::CornerMidpoint => CornerMidpoint.update(ctx, field),
+            DomainUpdateKind::Midpoint => Midpoint.update(ctx, field),
             other => Err(DomainError::Inadmissible {
                 rule: "gimp",
-                reason: format!(
-                    "domain_update = {other} convects corners or mid-points with the grid, which the explicit solver does not do"
-                ),
+                reason: format!("domain_update = {other} applies to basis = cpdi2"),
             }),
         }
     }
@@ -288,7 +284,7 @@ impl<const D: usize> Run<'_, '_, D> {
     fn with_basis<B, R>(self, basis: B, rule: R) -> Result<ExplicitOutput, SolverError>
     where
         B: BasisFunction<D, Mesh = RegularGrid<D>>,
-        B::Domain: FlatState + DomainBounds<D>,
+        B::Domain: Flat + DomainBounds<D>,
         R: DomainUpdater<D, B::Domain>,
     {
         let Some(material) = self.problem.materials.first() else {
@@ -343,7 +339,7 @@ impl<const D: usize> Run<'_, '_, D> {
     fn with_law<B, R, L>(self, basis: B, rule: R, law: L) -> Result<ExplicitOutput, SolverError>
     where
         B: BasisFunction<D, Mesh = RegularGrid<D>>,
-        B::Domain: FlatState + DomainBounds<D>,
+        B::Domain: Flat + DomainBounds<D>,
         R: DomainUpdater<D, B::Domain>,
         L: IncrementalLaw,
         L::State: FlatState,
@@ -370,7 +366,7 @@ impl<const D: usize> Run<'_, '_, D> {
     ) -> Result<ExplicitOutput, SolverError>
     where
         B: BasisFunction<D, Mesh = RegularGrid<D>>,
-        B::Domain: FlatState + DomainBounds<D>,
+        B::Domain: Flat + DomainBounds<D>,
         R: DomainUpdater<D, B::Domain>,
         L: IncrementalLaw,
         L::State: FlatState,
@@ -398,7 +394,7 @@ impl<const D: usize> Run<'_, '_, D> {
     ) -> Result<ExplicitOutput, SolverError>
     where
         B: BasisFunction<D, Mesh = RegularGrid<D>>,
-        B::Domain: FlatState + DomainBounds<D>,
+        B::Domain: Flat + DomainBounds<D>,
         R: DomainUpdater<D, B::Domain>,
         L: IncrementalLaw,
         L::State: FlatState,
@@ -689,7 +685,7 @@ impl Clock {
 
 /// A snapshot of the points after `steps` steps, with a checkpoint when
 /// the run keeps them.
-fn snapshot<const D: usize, S: FlatState, T: FlatState, Dom: FlatState + DomainBounds<D>>(
+fn snapshot<const D: usize, S: FlatState, T: FlatState, Dom: Flat + DomainBounds<D>>(
     points: &ExplicitPoints<D, S, T, Dom>,
     initial: &[SVector<f64, D>],
     time: f64,
@@ -833,23 +829,6 @@ impl FlatState for () {
     fn read(_: &[f64]) -> Self {}
 }
 
-/// A GIMP domain: its half-lengths.
-macro_rules! flat_half_lengths {
-    ($($d:literal),*) => {$(
-        impl FlatState for SVector<f64, $d> {
-            const LEN: usize = $d;
-            fn write(&self, out: &mut Vec<f64>) {
-                out.extend_from_slice(self.as_slice());
-            }
-            fn read(from: &[f64]) -> Self {
-                Self::from_column_slice(&from[..$d])
-            }
-        }
-    )*};
-}
-
-flat_half_lengths!(2, 3);
-
 impl<const D: usize> FlatState for VelocityGradient<D> {
     const LEN: usize = D * D;
     fn write(&self, out: &mut Vec<f64>) {
@@ -861,7 +840,7 @@ impl<const D: usize> FlatState for VelocityGradient<D> {
 }
 
 /// Numbers per point of [`write_points`].
-fn point_len<const D: usize, S: FlatState, T: FlatState, Dom: FlatState>() -> usize {
+fn point_len<const D: usize, S: FlatState, T: FlatState, Dom: Flat>() -> usize {
     2 * D + 3 + 18 + S::LEN + T::LEN + Dom::LEN
 }
 
@@ -870,7 +849,7 @@ fn point_len<const D: usize, S: FlatState, T: FlatState, Dom: FlatState>() -> us
 /// and the transfer's state, the basis's domain (none for bases without
 /// one). Point forces, fixities and initial domains are the scene's and
 /// not stored.
-fn write_points<const D: usize, S: FlatState, T: FlatState, Dom: FlatState>(
+fn write_points<const D: usize, S: FlatState, T: FlatState, Dom: Flat>(
     points: &ExplicitPoints<D, S, T, Dom>,
 ) -> Vec<f64> {
     let n = points.len();
@@ -891,7 +870,7 @@ fn write_points<const D: usize, S: FlatState, T: FlatState, Dom: FlatState>(
 
 /// [`write_points`] read back into `points` (the scene's points, which
 /// keep their point forces).
-fn read_points<const D: usize, S: FlatState, T: FlatState, Dom: FlatState>(
+fn read_points<const D: usize, S: FlatState, T: FlatState, Dom: Flat>(
     flat: &[f64],
     mut points: ExplicitPoints<D, S, T, Dom>,
 ) -> Result<ExplicitPoints<D, S, T, Dom>, SolverError> {
