@@ -70,8 +70,8 @@ impl VelocityFixities {
     /// for a node without fixities, a binary search otherwise.
     #[inline]
     pub fn held(&self, node: usize, component: usize) -> Option<f64> {
-        let bit = self.mask.get(node).copied().unwrap_or(0) >> component.min(7);
-        if component >= 8 || bit & 1 == 0 {
+        let held = component < 8 && self.mask.get(node).is_some_and(|m| m >> component & 1 == 1);
+        if !held {
             return None;
         }
         self.entries

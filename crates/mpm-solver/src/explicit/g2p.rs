@@ -113,29 +113,17 @@ pub fn grid_displacement<const D: usize, M: NodalMesh<D>>(
     x: &SVector<f64, D>,
     stencil: &mut mpm_basis::Stencil<D>,
 ) -> Result<SVector<f64, D>, DomainError> {
-    let at = || x.as_slice().to_vec();
-    mesh.shape_functions(x, stencil)
-        .map_err(|source| DomainError::Mesh { at: at(), source })?;
-    let mut sum = SVector::<f64, D>::zeros();
-    for (&node, &value) in stencil.nodes.iter().zip(&stencil.values) {
+    crate::stages::update::interpolate_nodal(mesh, x, stencil, ROUNDING_WEIGHT, |node| {
         // Entries outside lo..hi are stale; a node without mass has none.
-        let active = node >= grid.lo && node < grid.hi && grid.mass[node] > 0.0;
-        if !active {
-            if value.abs() <= ROUNDING_WEIGHT {
-                continue;
-            }
-            return Err(DomainError::InactiveNode { node, at: at() });
+        if !(node >= grid.lo && node < grid.hi && grid.mass[node] > 0.0) {
+            return None;
         }
         let v = &grid.velocity[node];
-        for i in 0..D {
-            let du = match fixities.held(node, i) {
-                Some(held) => dt * held,
-                None => 0.5 * dt * (v.old[i] + v.new[i]),
-            };
-            sum[i] += value * du;
-        }
-    }
-    Ok(sum)
+        Some(SVector::from_fn(|i, _| match fixities.held(node, i) {
+            Some(held) => dt * held,
+            None => 0.5 * dt * (v.old[i] + v.new[i]),
+        }))
+    })
 }
 
 /// $\mathbf 1 + \Delta t\,\nabla v$ embedded in 3×3 (plane strain: the

@@ -53,13 +53,46 @@ pub fn point_displacement<const D: usize>(
     u
 }
 
+/// $\sum_v N_v(\mathbf x)\,\mathbf u_v$ with the background mesh's own
+/// linear shape functions at `x`: the interpolation both solvers use to
+/// convect domain corners and mid-points (eq. 35). `nodal(v)` is the
+/// value $\mathbf u_v$ of node `v`, or `None` for a node without one this
+/// step; such a node may appear only with $|N_v(\mathbf x)| \le$
+/// `negligible` (then it adds nothing).
+///
+/// # Errors
+/// [`DomainError::Mesh`] when `x` is outside the mesh,
+/// [`DomainError::InactiveNode`] for a node without a value and a larger
+/// weight.
+#[inline]
+pub fn interpolate_nodal<const D: usize, M: NodalMesh<D>>(
+    mesh: &M,
+    x: &SVector<f64, D>,
+    stencil: &mut Stencil<D>,
+    negligible: f64,
+    mut nodal: impl FnMut(usize) -> Option<SVector<f64, D>>,
+) -> Result<SVector<f64, D>, DomainError> {
+    let at = || x.as_slice().to_vec();
+    mesh.shape_functions(x, stencil)
+        .map_err(|source| DomainError::Mesh { at: at(), source })?;
+    let mut u = SVector::<f64, D>::zeros();
+    for (&node, &value) in stencil.nodes.iter().zip(&stencil.values) {
+        match nodal(node) {
+            Some(u_v) => u += u_v * value,
+            None if value.abs() <= negligible => {}
+            None => return Err(DomainError::InactiveNode { node, at: at() }),
+        }
+    }
+    Ok(u)
+}
+
 /// The grid displacement increment interpolated at `x` (a point of the
 /// configuration at the start of the step) with the background mesh's own
 /// linear shape functions, $\Delta\mathbf u(\mathbf x) = \sum_v
-/// N_v(\mathbf x)\Delta\mathbf u_v$ (eq. 35); used by domain updates that
-/// convect corners or mid-points. Nodes outside the step's active set may
-/// appear only with a zero value (a corner on the face of a cell the
-/// domain does not enter).
+/// N_v(\mathbf x)\Delta\mathbf u_v$ (eq. 35, [`interpolate_nodal`]); used by
+/// domain updates that convect corners or mid-points. Nodes outside the
+/// step's active set may appear only with a zero value (a corner on the
+/// face of a cell the domain does not enter).
 pub fn displacement_at<const D: usize, M: NodalMesh<D>>(
     mesh: &M,
     sys: &StepSystem<D>,
@@ -67,24 +100,10 @@ pub fn displacement_at<const D: usize, M: NodalMesh<D>>(
     x: &SVector<f64, D>,
     stencil: &mut Stencil<D>,
 ) -> Result<SVector<f64, D>, DomainError> {
-    let at = || x.as_slice().to_vec();
-    mesh.shape_functions(x, stencil)
-        .map_err(|source| DomainError::Mesh { at: at(), source })?;
-    let mut u = SVector::<f64, D>::zeros();
-    for (a, &node) in stencil.nodes.iter().enumerate() {
-        let value = stencil.values[a];
+    interpolate_nodal(mesh, x, stencil, 0.0, |node| {
         let v = sys.active_of_mesh.get(node).copied().unwrap_or(NONE);
-        if v == NONE {
-            if value == 0.0 {
-                continue;
-            }
-            return Err(DomainError::InactiveNode { node, at: at() });
-        }
-        for i in 0..D {
-            u[i] += value * du[D * v as usize + i];
-        }
-    }
-    Ok(u)
+        (v != NONE).then(|| SVector::from_fn(|i, _| du[D * v as usize + i]))
+    })
 }
 
 /// Commits a converged step: for every point with a response, the
