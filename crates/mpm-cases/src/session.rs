@@ -152,6 +152,21 @@ impl<const D: usize, M: CellMesh<D>> Observer<D, M> {
         report: &StepReport<D>,
         snap: &Snapshot,
     ) -> Result<(), SolverError> {
+        for cut in &report.cuts {
+            let line = format!(
+                "step {} from load factor {:.4} to {:.4} cut (last residual {:.2e}): {}",
+                step + 1,
+                cut.lambda0,
+                cut.target,
+                cut.last_residual,
+                cut.cause
+            );
+            if self.plain {
+                eprintln!("{line}");
+            } else {
+                self.bar.println(line);
+            }
+        }
         let residual = report.residuals.last().copied().unwrap_or(0.0);
         let mut line = format!(
             "step {} to load factor {:.4} (increment {:.3e}): {} iterations, residual {:.2e}",

@@ -167,13 +167,36 @@ fn bad_input_fails_cleanly() {
 
 /// A step that cannot converge in the iterations allowed is halved down
 /// to the minimum and the run stops with a typed error naming the step,
-/// the last residual and the cause. A tolerance below round-off is met at
-/// the rounding floor instead, and the run says so. Points pulled out of
-/// the grid stop the run with an error naming the point.
+/// the last residual and the cause; every halving on the way is logged
+/// with its cause. A tolerance below round-off is met at the rounding floor
+/// instead, and the run says so. Points pulled out of the grid stop the run
+/// with an error naming the point.
 #[test]
 fn non_convergence_and_points_leaving_the_grid_are_diagnosed() {
     let dir = temp_dir("diverge");
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/coombs2020_column.toml");
+    // Two iterations are too few for some steps of 0.05: each is halved,
+    // the halving logged, and the run completes (16 cuts).
+    let (ok, out, err) = mpm(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--set",
+        "solver.max_iterations=2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let cuts: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains(" cut (last residual "))
+        .collect();
+    assert_eq!(cuts.len(), 16, "{err}");
+    assert!(
+        cuts[0].starts_with("step 1 from load factor 0.0000 to 0.0500 cut")
+            && cuts[0].contains("no convergence in 2 iterations"),
+        "{err}"
+    );
+    assert!(out.contains("(16 cut)"), "{out}");
     let (ok, _, err) = mpm(&[
         "run",
         scene.to_str().unwrap(),

@@ -101,8 +101,8 @@ pub use explicit::{
 };
 pub use formulation::{Formulation, PreviouslyConverged, UpdatedLagrangian};
 pub use implicit::{
-    FirstTangent, FreeStiffness, ImplicitBuilder, ImplicitSolver, NewtonOptions, StageTimes,
-    StepError, StepReport,
+    CutStep, FirstTangent, FreeStiffness, ImplicitBuilder, ImplicitSolver, NewtonOptions,
+    StageTimes, StepError, StepReport,
 };
 pub use linear::{
     AutoLinear, DEFAULT_MAX_DIRECT_DOFS_2D, DEFAULT_MAX_DIRECT_DOFS_3D, Factorisation, FaerDirect,

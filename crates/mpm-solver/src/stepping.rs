@@ -4,7 +4,7 @@
 //! error naming the step, the last residual and the cause.
 
 use crate::error::SolverError;
-use crate::implicit::{FreeStiffness, ImplicitSolver, StepError, StepReport};
+use crate::implicit::{CutStep, FreeStiffness, ImplicitSolver, StepError, StepReport};
 use crate::parts::{PointsOf, SolverParts};
 
 /// The smallest load increment an analysis accepts. The load factor in
@@ -144,10 +144,12 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let mut lambda = state.load_factor;
         let mut increment = state.increment.min(stepping.max);
         const END: f64 = 1.0 - 1e-12;
+        let mut cuts = Vec::new();
         while lambda < END {
             let target = (lambda + increment).min(1.0);
             match self.solve_load_step(points, lambda, target) {
-                Ok(report) => {
+                Ok(mut report) => {
+                    report.cuts = std::mem::take(&mut cuts);
                     summary.steps += 1;
                     summary.iterations += report.iterations();
                     lambda = target;
@@ -180,7 +182,14 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                     summary.cut_steps += 1;
                     let tried = target - lambda;
                     increment = 0.5 * tried;
-                    if increment < stepping.min {
+                    if increment >= stepping.min {
+                        cuts.push(CutStep {
+                            lambda0: lambda,
+                            target,
+                            last_residual,
+                            cause,
+                        });
+                    } else {
                         return Err(SolverError::StepTooSmall {
                             step: summary.steps,
                             load_factor: lambda,

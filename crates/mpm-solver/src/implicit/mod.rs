@@ -40,7 +40,7 @@ mod verification;
 
 pub use builder::ImplicitBuilder;
 pub use options::{FirstTangent, MAX_BACKTRACKS, NewtonOptions};
-pub use report::{FreeStiffness, StageTimes, StepError, StepReport};
+pub use report::{CutStep, FreeStiffness, StageTimes, StepError, StepReport};
 
 use mpm_constitutive::Response;
 use mpm_constitutive::tensor::Tensor4;
@@ -288,6 +288,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             linearised_start,
             times,
             linear_iterations,
+            cuts: Vec::new(),
         })
     }
 

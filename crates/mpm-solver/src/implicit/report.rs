@@ -57,6 +57,25 @@ pub struct StepReport<const D: usize> {
     /// Iterations of the iterative linear solver over the step (0 with a
     /// direct solver).
     pub linear_iterations: usize,
+    /// The attempts from `lambda0` that failed and were halved before this
+    /// step converged, in order (filled by [`crate::ImplicitSolver::run`];
+    /// empty from `solve_load_step` and in most steps).
+    pub cuts: Vec<CutStep>,
+}
+
+/// A load step that failed and was halved: from `lambda0` towards
+/// `target`, with the normalised residual it last reached (NaN when it
+/// failed before the first one) and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CutStep {
+    /// Load factor the attempt started from.
+    pub lambda0: f64,
+    /// Load factor it aimed at.
+    pub target: f64,
+    /// Last normalised residual (eq. 40) of the attempt.
+    pub last_residual: f64,
+    /// Why it failed.
+    pub cause: StepFailure,
 }
 
 /// Wall-clock seconds per stage of a load step, summed over its Newton
