@@ -63,10 +63,14 @@ pub fn section(full: bool, img: &Path) -> Result<String> {
          z = 6 m (Fig. 10). The mesh at and above the ground moves down with the footing and \
          the mesh below it is compressed (the scene's `translation` motion: the bottom stays, \
          node v moves by w_v u with w_v = z_v/5 m below the ground), so that the footing's \
-         nodes stay nodes of the mesh. The footing goes down {SETTLEMENT} m under automatic \
+         nodes stay nodes of the mesh. The footing is a rigid block: its nodes from the ground \
+         to the top of the empty layer are driven, so that material heaving at its edge cannot \
+         flow onto it, inside its footprint, where only free nodes of the empty layer would \
+         hold it (the paper names the footing area only; with the area alone, F-patch failed \
+         from 0.65 m). The footing goes down {SETTLEMENT} m under automatic \
          steps: the first is 0.1 m, each converged step doubles the next, a failed one is \
          repeated at half. Mesh: {}; 11 points per linear child (Keast). Force: the vertical \
-         reaction of the footing's nodes in the quarter model.\n",
+         reaction of the footing block's nodes in the quarter model.\n",
         if full {
             "the footing scene's 7 × 7 × 7 rectilinear cells plus three above the ground"
         } else {

@@ -78,9 +78,18 @@ fn indentation_moves_the_mesh_with_the_footing_and_doubles_its_steps() {
             }
         }
         assert_eq!(checked, 5 * 5 * levels.len());
+        // The footing, a rigid block from the ground to the top of the
+        // empty layer: its base at 4 m, every node of it 1 m down.
+        let nodes = mesh.nodes();
+        let mut base = 0;
         for &v in &footing.nodes {
-            assert!((moved[v][2] - 4.0).abs() < 1e-12, "footing node {v}");
+            assert!(
+                (moved[v][2] - (nodes[v][2] - 1.0)).abs() < 1e-12,
+                "footing node {v}"
+            );
+            base += usize::from((moved[v][2] - 4.0).abs() < 1e-12);
         }
+        assert!(base > 0 && base < footing.nodes.len(), "{base}");
     }
     assert!(
         end_force[1] < end_force[0],
