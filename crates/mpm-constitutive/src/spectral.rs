@@ -363,9 +363,9 @@ mod tests {
 
     #[test]
     fn closed_form_is_backward_stable_on_clustered_graded_and_scaled_spectra() {
-        // Deterministic pseudo-random rotations and spectra: exactly and
-        // nearly repeated pairs and triples (gaps 1e-3 … 1e-15 relative),
-        // graded spectra, nearly isotropic tensors I + δ, scaled by 1e±90.
+        // Deterministic pseudo-random rotations and spectra: nearly
+        // repeated pairs and triples (gaps 1 … 1e-15 relative), graded
+        // spectra, nearly isotropic tensors I + δ, scaled by 1e±90.
         let mut state = 0x2545_f491_4f6c_dd1d_u64;
         let mut uniform = move || {
             state ^= state << 13;
