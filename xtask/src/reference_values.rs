@@ -682,7 +682,7 @@ fn stretch_file(workspace: &Path, time: &mut f64) -> Result<CaseRuns> {
                 ..StretchParams::default()
             },
             with_formulation(linear(), f),
-            "tests/stretch.rs, no predictor: a necked equilibrium".into(),
+            "tests/stretch.rs, no predictor: the homogeneous branch".into(),
             None,
         ));
     }

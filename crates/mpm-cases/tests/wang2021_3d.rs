@@ -115,8 +115,10 @@ fn plate(cells: &str, locking: &str) -> (f64, Vec<usize>) {
 
 /// §5.4: the reaction falls as the mesh is refined (h = 2 to 1 mm), F-patch
 /// carries less than standard MPM on each mesh (Fig. 15C), and F-patch's
-/// Newton iterations stay at four to six per step once the ligament yields
-/// (Fig. 16: four to five).
+/// Newton iterations stay at two to five per step once the ligament
+/// yields (Fig. 16: four to five). Until 2026-12-05, with the elastic
+/// branch at the yield surface in each step's first solve, they were four
+/// to six and this test asserted that range.
 #[test]
 fn notched_plate_reaction_falls_with_h_and_fpatch_below_standard() {
     let (standard_2, _) = plate("[2, 4, 1]", "none");
@@ -133,7 +135,7 @@ fn notched_plate_reaction_falls_with_h_and_fpatch_below_standard() {
     );
     for its in [&iterations_2, &iterations_1] {
         assert!(
-            its[5..].iter().all(|&n| (4..=6).contains(&n)),
+            its[5..].iter().all(|&n| (2..=5).contains(&n)),
             "F-patch iterations per step: {its:?}"
         );
     }

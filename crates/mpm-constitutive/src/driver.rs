@@ -168,6 +168,16 @@ impl TangentParts {
             dlog: r.trial_be.dlog()?,
         })
     }
+
+    /// $D$ for continued loading ([`LogStrainLaw::loading_tangent`]) and
+    /// $L$ of a response.
+    pub fn loading<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Self> {
+        let d_alg = law.loading_tangent(&r.trial_strain(), &r.history_n, &r.law_state);
+        Ok(Self {
+            d_alg,
+            dlog: r.trial_be.dlog()?,
+        })
+    }
 }
 
 /// A consistent tangent of one formulation: the plug point through which
@@ -179,6 +189,11 @@ pub trait ConsistentTangent: Send + Sync + 'static {
     /// Convenience: the tangent straight from the law and the response.
     fn tangent<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Tensor4> {
         Ok(Self::assemble(r, &TangentParts::new(law, r)?))
+    }
+
+    /// The tangent for continued loading ([`TangentParts::loading`]).
+    fn loading_tangent<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Tensor4> {
+        Ok(Self::assemble(r, &TangentParts::loading(law, r)?))
     }
 }
 

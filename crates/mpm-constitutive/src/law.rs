@@ -61,6 +61,26 @@ pub trait LogStrainLaw: Send + Sync {
         state: &LawState<Self::History>,
     ) -> Tensor4;
 
+    /// The tangent for continued loading: equal to
+    /// [`Self::algorithmic_tangent`] except at a trial state *on* the
+    /// yield surface, where the return map has a kink (taken as elastic by
+    /// [`Self::return_map`]) and this is the one-sided derivative for
+    /// plastic loading. A load step starts at such states ($\Delta F = 1$
+    /// for the points that yielded in the last step); the solver's first
+    /// solve of a displacement-driven step (`FirstTangent::Converged`)
+    /// takes its stiffness from this tangent, so that the points that
+    /// flowed are not treated as elastic (docs/src/theory/constitutive.md,
+    /// "The tangent on the yield surface"). The default, for laws without
+    /// a yield surface, is the algorithmic tangent.
+    fn loading_tangent(
+        &self,
+        trial: &SymSpectral,
+        history: &Self::History,
+        state: &LawState<Self::History>,
+    ) -> Tensor4 {
+        self.algorithmic_tangent(trial, history, state)
+    }
+
     /// The law's small-strain elastic constants, when it has isotropic
     /// ones: explicit solvers take the wave speed of eq. (46) of the MPoint
     /// notes from them. `None` by default.

@@ -120,6 +120,22 @@ impl<L: LogStrainLaw> LogStrainLaw for MaterialSet<L> {
         self.law(history.material)
             .algorithmic_tangent(trial, &history.inner, &inner)
     }
+
+    fn loading_tangent(
+        &self,
+        trial: &SymSpectral,
+        history: &Self::History,
+        state: &LawState<Self::History>,
+    ) -> Tensor4 {
+        let inner = LawState {
+            tau: state.tau,
+            elastic_strain: state.elastic_strain,
+            history: state.history.inner,
+            yielded: state.yielded,
+        };
+        self.law(history.material)
+            .loading_tangent(trial, &history.inner, &inner)
+    }
 }
 
 #[cfg(test)]

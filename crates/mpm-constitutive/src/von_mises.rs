@@ -114,9 +114,8 @@ impl VonMises {
     /// is the rounding of $\rho^{tr}$ when the trial strain is recomputed
     /// as $\ln b^e$ from a stored $b^e = \exp 2\varepsilon^e$ (an absolute
     /// error of a few $\epsilon$ in each strain). Such a state is a
-    /// converged plastic state read again at $\Delta F = 1$: the first
-    /// tangent of a load step (see [`LogStrainLaw::algorithmic_tangent`]
-    /// for this law).
+    /// converged plastic state read again at $\Delta F = 1$, where a load
+    /// step starts ([`LogStrainLaw::loading_tangent`]).
     #[inline]
     fn on_yield_surface(&self, rho_tr: f64, eps: &Vector3<f64>, history: &VonMisesHistory) -> bool {
         let rounding = 16.0 * f64::EPSILON * 2.0 * self.elasticity.mu * eps.norm().max(1.0);
@@ -130,6 +129,28 @@ impl VonMises {
         let s = eps.map(|e| 2.0 * self.elasticity.mu * (e - mean));
         let rho = s.norm();
         (s, rho)
+    }
+
+    /// The algorithmic tangent of a plastic return with multiplier
+    /// $\Delta\gamma$ = `state.history.alpha - history.alpha` (0 on the
+    /// yield surface: the continuum tangent).
+    fn plastic_tangent(
+        &self,
+        trial: &SymSpectral,
+        history: &VonMisesHistory,
+        state: &LawState<VonMisesHistory>,
+    ) -> Tensor4 {
+        let el = &self.elasticity;
+        let (s_tr, rho_tr) = self.trial_deviator(&trial.values);
+        let dgamma = state.history.alpha - history.alpha;
+        let two_mu = 2.0 * el.mu;
+        let theta = 1.0 - two_mu * dgamma / rho_tr;
+        let theta_bar = two_mu / (two_mu + self.hardening) - (1.0 - theta);
+        let n = trial.compose(&(s_tr / rho_tr));
+        let one = Matrix3::identity();
+        let one_one = dyad(&one, &one);
+        let dev = sym_identity() - one_one / 3.0;
+        el.bulk * one_one + two_mu * theta * dev - two_mu * theta_bar * dyad(&n, &n)
     }
 }
 
@@ -167,41 +188,36 @@ impl LogStrainLaw for VonMises {
         }
     }
 
-    /// The consistent tangent of the radial return (docs/src/theory/
-    /// constitutive.md §"Von Mises with linear isotropic hardening").
-    ///
-    /// On the yield surface itself ($f^{tr} = 0$ to rounding, taken as
-    /// elastic by [`Self::return_map`]) the return map has a kink and no
-    /// derivative. There the tangent is the one-sided derivative for
-    /// plastic loading, the formula with $\Delta\gamma = 0$ (the continuum
-    /// elasto-plastic tangent), not the elastic one. Away from the kink
-    /// nothing changes. The state arises when a load step starts: at
-    /// $\Delta F = 1$ each point that yielded in the last step is read
-    /// again on the surface, and the solver's first tangent
-    /// (`FirstTangent::Converged`) is built there. With the elastic
-    /// tangent those points look far too stiff and the first Newton
-    /// iterate overshoots (Wang 2021 §5.4, h = 2 mm: 113 iterations in
-    /// 25 steps with it, 67 with this one).
     fn algorithmic_tangent(
         &self,
         trial: &SymSpectral,
         history: &VonMisesHistory,
         state: &LawState<VonMisesHistory>,
     ) -> Tensor4 {
-        let el = &self.elasticity;
-        let (s_tr, rho_tr) = self.trial_deviator(&trial.values);
-        if !state.yielded && !self.on_yield_surface(rho_tr, &trial.values, history) {
-            return el.stiffness();
+        if !state.yielded {
+            return self.elasticity.stiffness();
         }
-        let dgamma = state.history.alpha - history.alpha;
-        let two_mu = 2.0 * el.mu;
-        let theta = 1.0 - two_mu * dgamma / rho_tr;
-        let theta_bar = two_mu / (two_mu + self.hardening) - (1.0 - theta);
-        let n = trial.compose(&(s_tr / rho_tr));
-        let one = Matrix3::identity();
-        let one_one = dyad(&one, &one);
-        let dev = sym_identity() - one_one / 3.0;
-        el.bulk * one_one + two_mu * theta * dev - two_mu * theta_bar * dyad(&n, &n)
+        self.plastic_tangent(trial, history, state)
+    }
+
+    /// On the yield surface ($f^{tr} = 0$ to rounding, which
+    /// [`Self::return_map`] takes as elastic) the tangent of continued
+    /// plastic loading: the formula of the algorithmic tangent with
+    /// $\Delta\gamma = 0$, the continuum elasto-plastic tangent. Elsewhere
+    /// the algorithmic tangent.
+    fn loading_tangent(
+        &self,
+        trial: &SymSpectral,
+        history: &VonMisesHistory,
+        state: &LawState<VonMisesHistory>,
+    ) -> Tensor4 {
+        if !state.yielded {
+            let (_, rho_tr) = self.trial_deviator(&trial.values);
+            if !self.on_yield_surface(rho_tr, &trial.values, history) {
+                return self.elasticity.stiffness();
+            }
+        }
+        self.plastic_tangent(trial, history, state)
     }
 
     fn elasticity(&self) -> Option<IsotropicElasticity> {

@@ -304,6 +304,17 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// Stage 4c: the formulation's consistent tangent at every point,
     /// weighted by its integration volume.
     pub fn update_tangents(&mut self, points: &PointsOf<D, P>) -> Result<(), StepFailure> {
+        self.update_tangents_with::<false>(points)
+    }
+
+    /// [`Self::update_tangents`] with each law's algorithmic tangent
+    /// (`LOADING = false`) or its tangent for continued loading
+    /// (`LogStrainLaw::loading_tangent`, `LOADING = true`), which differ
+    /// only for points on a yield surface.
+    fn update_tangents_with<const LOADING: bool>(
+        &mut self,
+        points: &PointsOf<D, P>,
+    ) -> Result<(), StepFailure> {
         let law = &self.law;
         let it = &mut self.it;
         it.tangent_w.resize(it.responses.len(), Tensor4::zeros());
@@ -317,7 +328,11 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                     // Read in place and scaled into `t`: moving the tensor
                     // out of its `Result` and multiplying by value are two
                     // 648-byte copies the compiler does not elide.
-                    let tangent = <P::Formulation as Formulation>::Tangent::tangent(law, r);
+                    let tangent = if LOADING {
+                        <P::Formulation as Formulation>::Tangent::loading_tangent(law, r)
+                    } else {
+                        <P::Formulation as Formulation>::Tangent::tangent(law, r)
+                    };
                     match &tangent {
                         Ok(a) => t.zip_apply(a, |x, y| *x = y * volume),
                         Err(source) => {
@@ -342,7 +357,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// $K_{ff}(0)\,\Delta\mathbf u_f = \mathbf f^{ext}_f - \mathbf
     /// f^{int}_f(0) - K_{fp}(0)\,\Delta\mathbf u_p$. $K_{ff}(0)$ is the
     /// stiffness at zero increment (every point's tangent at $\Delta F = I$
-    /// with its committed state); the coupling $K_{fp}(0)\Delta\mathbf
+    /// with its committed state, for continued loading where a point sits
+    /// on its yield surface: `LogStrainLaw::loading_tangent`); the coupling $K_{fp}(0)\Delta\mathbf
     /// u_p$, whose block the free-dof assembly does not hold, is the
     /// forward difference $[\mathbf f^{int}(\epsilon\Delta\mathbf u_p) -
     /// \mathbf f^{int}(0)]/\epsilon$ with $\epsilon$ =
@@ -358,7 +374,9 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         self.update_material_points(points)?;
         self.assemble_internal_force();
         let f0 = self.it.f_int.clone();
-        self.update_tangents(points)?;
+        // The points that yielded in the last step sit on the yield
+        // surface; the increment continues their loading.
+        self.update_tangents_with::<true>(points)?;
         self.assemble_stiffness();
         let eps = LINEARISED_START_STEP;
         for (u, p) in self.it.du.iter_mut().zip(&prescribed) {
