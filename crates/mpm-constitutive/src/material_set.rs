@@ -111,30 +111,30 @@ impl<L: LogStrainLaw> LogStrainLaw for MaterialSet<L> {
         history: &Self::History,
         state: &LawState<Self::History>,
     ) -> Tensor4 {
-        let inner = LawState {
-            tau: state.tau,
-            elastic_strain: state.elastic_strain,
-            history: state.history.inner,
-            yielded: state.yielded,
-        };
         self.law(history.material)
-            .algorithmic_tangent(trial, &history.inner, &inner)
+            .algorithmic_tangent(trial, &history.inner, &untagged(state))
     }
 
+    #[inline]
     fn loading_tangent(
         &self,
         trial: &SymSpectral,
         history: &Self::History,
         state: &LawState<Self::History>,
     ) -> Tensor4 {
-        let inner = LawState {
-            tau: state.tau,
-            elastic_strain: state.elastic_strain,
-            history: state.history.inner,
-            yielded: state.yielded,
-        };
         self.law(history.material)
-            .loading_tangent(trial, &history.inner, &inner)
+            .loading_tangent(trial, &history.inner, &untagged(state))
+    }
+}
+
+/// The member law's state of a set's state (the tag removed).
+#[inline]
+fn untagged<H: Copy>(state: &LawState<Tagged<H>>) -> LawState<H> {
+    LawState {
+        tau: state.tau,
+        elastic_strain: state.elastic_strain,
+        history: state.history.inner,
+        yielded: state.yielded,
     }
 }
 
