@@ -179,6 +179,9 @@ pub enum SolverError {
     /// last converged step is intact.
     #[error("output or observer after a converged step: {0}")]
     Observer(#[source] ObserverError),
+    /// The ghost penalty cannot be applied to this solver's parts.
+    #[error("ghost penalty: {0}")]
+    Ghost(&'static str),
     /// The locking treatment could not place the points in patches.
     #[error("locking treatment: {0}")]
     Locking(#[from] LockingError),

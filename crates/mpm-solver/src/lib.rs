@@ -114,4 +114,5 @@ pub use mesh::{MovableMesh, NodalMesh};
 pub use moving_mesh::{MeshMotion, MovingMesh, Rotation, Stretch, Translation};
 pub use parts::{Parts, PointsOf, SolverParts};
 pub use points::{BodyForcePath, MaterialPoints};
+pub use stages::ghost::GhostPenalty;
 pub use stepping::{LoadStepping, MIN_LOAD_INCREMENT, RunState, RunSummary, StepContext};

@@ -23,12 +23,23 @@ pub trait NodalMesh<const D: usize>: Send + Sync {
     /// # Errors
     /// A [`BasisError`] when `x` lies outside the mesh.
     fn shape_functions(&self, x: &SVector<f64, D>, out: &mut Stencil<D>) -> Result<(), BasisError>;
+
+    /// The mesh as a regular grid, for the stages defined on one (the
+    /// ghost penalty, [`crate::stages::ghost`]); `None` (the default) for
+    /// other meshes.
+    fn regular_grid(&self) -> Option<&RegularGrid<D>> {
+        None
+    }
 }
 
 impl<const D: usize> NodalMesh<D> for RegularGrid<D> {
     #[inline]
     fn node_count(&self) -> usize {
         RegularGrid::node_count(self)
+    }
+
+    fn regular_grid(&self) -> Option<&RegularGrid<D>> {
+        Some(self)
     }
 
     /// The multilinear functions of the cell containing `x`. A point up to

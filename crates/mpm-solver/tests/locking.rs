@@ -13,9 +13,9 @@ use mpm_basis::{BasisFunction, Gimp, LinearMpm, LinearSimplex};
 use mpm_constitutive::{HenckyElastic, LogStrainLaw, VonMises};
 use mpm_mesh::{BoxMesh, PatchMesh, RegularGrid, SimplexMesh, SplitMix64};
 use mpm_solver::{
-    FBar, FPatch, FirstTangent, Formulation, ImplicitSolver, LoadStepping, LockingTreatment,
-    MaterialPoints, NewtonOptions, NoUpdate, NodalConstraints, NodalMesh, Parts,
-    PreviouslyConverged, UpdatedLagrangian,
+    FBar, FPatch, FirstTangent, Formulation, GhostPenalty, ImplicitSolver, LoadStepping,
+    LockingTreatment, MaterialPoints, NewtonOptions, NoLocking, NoUpdate, NodalConstraints,
+    NodalMesh, Parts, PreviouslyConverged, UpdatedLagrangian,
 };
 use nalgebra::{Matrix3, Rotation3, SVector, Vector3};
 use proptest::prelude::*;
@@ -126,6 +126,33 @@ where
     F: Formulation,
     L: LogStrainLaw,
 {
+    grid_case::<D, B, F, L, _>(
+        basis,
+        law,
+        domain,
+        FBar { cells_per_patch },
+        GhostPenalty::OFF,
+        seed,
+    )
+}
+
+/// [`fbar_case`] with any treatment `locking` and the ghost penalty
+/// `ghost`; when the penalty is on, about a third of the points are
+/// dropped at random so that cells are cut and their faces penalised.
+fn grid_case<const D: usize, B, F, L, K>(
+    basis: B,
+    law: L,
+    domain: B::Domain,
+    locking: K,
+    ghost: GhostPenalty,
+    seed: u64,
+) -> f64
+where
+    B: BasisFunction<D, Mesh = RegularGrid<D>>,
+    F: Formulation,
+    L: LogStrainLaw,
+    K: LockingTreatment<D, RegularGrid<D>>,
+{
     let mut rng = SplitMix64(seed);
     let (pad, h) = (1usize, 0.5);
     let grid = RegularGrid::new(
@@ -134,7 +161,10 @@ where
         [3 + 2 * pad; D],
     )
     .unwrap();
-    let position = grid_points::<D>(&mut rng, 2);
+    let mut position = grid_points::<D>(&mut rng, 2);
+    if ghost.is_on() {
+        position.retain(|_| rng.next_unit() < 0.65);
+    }
     let n = position.len();
     let volume = vec![(h / 2.0).powi(D as i32); n];
     let mut points: Points<D, L, B::Domain> =
@@ -146,18 +176,15 @@ where
     let constraints = base_fixed(&grid, |n| grid.node_position(n).unwrap());
     let options = NewtonOptions {
         weak_node_threshold: 0.0,
+        ghost,
         ..NewtonOptions::default()
     };
-    let mut solver: ImplicitSolver<D, Parts<B, F, L, FBar, NoUpdate, _>> = ImplicitSolver::new(
-        basis,
-        grid,
-        law,
-        FBar { cells_per_patch },
-        NoUpdate,
-        constraints,
-        options,
-    );
-    fd_error(&mut solver, &points, &mut rng, 0.02)
+    let mut solver: ImplicitSolver<D, Parts<B, F, L, K, NoUpdate, _>> =
+        ImplicitSolver::new(basis, grid, law, locking, NoUpdate, constraints, options);
+    let error = fd_error(&mut solver, &points, &mut rng, 0.02);
+    let faces = solver.ghost_face_count();
+    assert_eq!(faces > 0, ghost.is_on(), "{faces} penalised faces");
+    error
 }
 
 /// A graded box of split tri6/tet10 parents with `per` random points in
@@ -271,6 +298,30 @@ proptest! {
         for e in [
             fbar_case::<3, _, UpdatedLagrangian, _>(LinearMpm, elastic(), (), 1, seed),
             fbar_case::<3, _, PreviouslyConverged, _>(LinearMpm, plastic(), (), 1, seed),
+        ] {
+            prop_assert!(e <= TOL, "relative error {e:e}");
+        }
+    }
+
+    /// The ghost penalty (strong, γ = 0.5, so that its share of the
+    /// stiffness is not lost in the tolerance) with and without F-bar.
+    #[test]
+    fn ghost_penalty_2d(seed in any::<u64>()) {
+        let ghost = GhostPenalty::new(0.5);
+        for e in [
+            grid_case::<2, _, PreviouslyConverged, _, _>(LinearMpm, plastic(), (), FBar::default(), ghost, seed),
+            grid_case::<2, _, UpdatedLagrangian, _, _>(LinearMpm, elastic(), (), NoLocking, ghost, seed),
+        ] {
+            prop_assert!(e <= TOL, "relative error {e:e}");
+        }
+    }
+
+    #[test]
+    fn ghost_penalty_3d(seed in any::<u64>()) {
+        let ghost = GhostPenalty::new(0.5);
+        for e in [
+            grid_case::<3, _, UpdatedLagrangian, _, _>(LinearMpm, plastic(), (), FBar::default(), ghost, seed),
+            grid_case::<3, _, PreviouslyConverged, _, _>(LinearMpm, elastic(), (), NoLocking, ghost, seed),
         ] {
             prop_assert!(e <= TOL, "relative error {e:e}");
         }

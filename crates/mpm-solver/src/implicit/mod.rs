@@ -56,6 +56,7 @@ fn lap(clock: Instant) -> f64 {
 }
 use crate::parts::{PointsOf, SolverParts};
 use crate::stages::convergence::{self, NewtonMonitor, Verdict};
+use crate::stages::ghost::GhostFaces;
 use crate::stages::patch::PatchSystem;
 use crate::stages::system::StepSystem;
 
@@ -123,6 +124,8 @@ pub struct ImplicitSolver<const D: usize, P: SolverParts<D>> {
     system: StepSystem<D>,
     /// The patches of a coupled locking treatment (empty otherwise).
     patches: PatchSystem<D>,
+    /// The faces of the ghost penalty (empty when it is off).
+    ghost: GhostFaces,
     it: Iterate<D, P::History>,
     /// The last converged increment per mesh dof and its load increment.
     previous: Option<(Vec<f64>, f64)>,
@@ -159,6 +162,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             analysed: false,
             system: StepSystem::default(),
             patches: PatchSystem::default(),
+            ghost: GhostFaces::default(),
             it: Iterate::default(),
             previous: None,
             hints: Vec::new(),
@@ -298,6 +302,12 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     pub fn normalised_residual(&self) -> f64 {
         let (r, d) = convergence::residual_parts(&self.system, &self.it.f_int, &self.it.f_ext);
         convergence::ratio(r, d)
+    }
+
+    /// The number of faces the ghost penalty acts on in the current load
+    /// step ([`crate::NewtonOptions::ghost`]; zero when it is off).
+    pub fn ghost_face_count(&self) -> usize {
+        self.ghost.len()
     }
 
     /// The stiffness last assembled on the current load step's system (in

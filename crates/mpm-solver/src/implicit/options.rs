@@ -66,6 +66,10 @@ pub struct NewtonOptions {
     /// The tangent of a step's first solve when the step starts from
     /// prescribed increments alone (no predictor).
     pub first_tangent: FirstTangent,
+    /// The ghost penalty on the faces of cut cells
+    /// ([`crate::stages::ghost`]; off by default). It needs a regular grid
+    /// and a law with an elastic shear modulus.
+    pub ghost: crate::stages::ghost::GhostPenalty,
     /// The linear solver [`crate::ImplicitSolver::new`] builds.
     pub linear: crate::linear::LinearChoice,
 }
@@ -105,6 +109,7 @@ impl Default for NewtonOptions {
             max_increment_norm: 10.0,
             rounding_floor_factor: 10.0,
             first_tangent: FirstTangent::Converged,
+            ghost: crate::stages::ghost::GhostPenalty::OFF,
             linear: crate::linear::LinearChoice::default(),
         }
     }

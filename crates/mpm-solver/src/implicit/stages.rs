@@ -77,6 +77,32 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let sys = &mut self.system;
         sys.number_nodes(node_count);
         sys.build_adjacency();
+        let ghost = &mut self.ghost;
+        if self.options.ghost.is_on() {
+            let grid = self
+                .mesh
+                .regular_grid()
+                .ok_or(SolverError::Ghost("it is defined on regular grids only"))?;
+            let mu = self
+                .law
+                .elasticity()
+                .ok_or(SolverError::Ghost(
+                    "it scales with the law's shear modulus, and this law gives none",
+                ))?
+                .mu;
+            let g = self.options.ghost;
+            ghost.build(
+                grid,
+                &points.position,
+                volumes,
+                sys,
+                g.factor * 2.0 * mu,
+                g.fill,
+            )?;
+        } else {
+            ghost.clear();
+        }
+        let ghost = &self.ghost;
         if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
             let input = PatchInput {
                 position: &points.position,
@@ -87,9 +113,15 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 .assign(&self.mesh, input, &mut self.patches.assignment)?;
             self.patches.build(sys);
             sys.build_patch_neighbours(&self.patches);
+            if !ghost.is_empty() {
+                sys.extend_neighbours(|w, push| ghost.partners(w, push));
+            }
             self.patches.build_placement(sys);
         } else {
             sys.build_neighbours();
+            if !ghost.is_empty() {
+                sys.extend_neighbours(|w, push| ghost.partners(w, push));
+            }
         }
         let (support, stiffness) = gather::support_weights(sys, volumes);
         let max = |x: &[f64]| x.iter().copied().fold(0.0, f64::max);
@@ -298,6 +330,9 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             &self.it.stress_w,
             &mut f_int,
         );
+        if !self.ghost.is_empty() {
+            self.ghost.add_force::<D>(&self.it.du, &mut f_int);
+        }
         self.it.f_int = f_int;
     }
 
@@ -455,6 +490,9 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         );
         if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
             gather::patch_coupling(&self.system, &self.patches, &mut values);
+        }
+        if !self.ghost.is_empty() {
+            self.ghost.add_stiffness(&self.system, &mut values);
         }
         self.it.values = values;
         self.it.stiffness_assembled = true;

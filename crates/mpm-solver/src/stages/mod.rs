@@ -10,6 +10,7 @@
 //! | [`basis`] | basis values and gradients at the points | eqs. 8, 21 |
 //! | [`gather`] | point-to-grid: mass, external and internal force, stiffness | eqs. 4, 6, 21, 23–29 |
 //! | [`update`] | grid-to-point: ΔF, positions, volumes, domains | eqs. 7, 22, 31, 35 |
+//! | [`ghost`] | ghost penalty on the faces of cut cells | Coombs 2023 (not in the three references) |
 //! | [`patch`] | patch averages of a locking treatment, their coupling | Wang et al. 2021 eqs. 9–12 |
 //! | [`convergence`] | out-of-balance force, reactions, the Newton test | eq. 40 |
 //!
@@ -19,6 +20,7 @@
 pub mod basis;
 pub mod convergence;
 pub mod gather;
+pub mod ghost;
 pub mod patch;
 pub mod system;
 pub mod update;

@@ -191,6 +191,29 @@ impl<const D: usize> StepSystem<D> {
         );
     }
 
+    /// Adds to every neighbour list the nodes `extra(w, push)` pushes for
+    /// node `w` (the partners of a ghost-penalty face,
+    /// [`crate::stages::ghost::GhostFaces::partners`]); lists stay sorted
+    /// and duplicate-free. Call it before anything records positions in
+    /// the lists (the patch placement, [`Self::build_pattern`]).
+    pub fn extend_neighbours(&mut self, extra: impl Fn(usize, &mut dyn FnMut(u32))) {
+        let (old_ptr, old) = (
+            std::mem::take(&mut self.nb_ptr),
+            std::mem::take(&mut self.nb),
+        );
+        neighbour_lists(
+            self.active.len(),
+            &mut self.nb_ptr,
+            &mut self.nb,
+            |w, push| {
+                for &v in &old[old_ptr[w]..old_ptr[w + 1]] {
+                    push(v);
+                }
+                extra(w, push);
+            },
+        );
+    }
+
     /// Whether every dof of active node `v` is free (after
     /// [`Self::build_pattern`]).
     #[inline]
