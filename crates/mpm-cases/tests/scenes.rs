@@ -1768,3 +1768,53 @@ fn weak_node_keys_and_the_gimp_base_reaction() {
     assert!(held > 0.01 && (held - free).abs() < 1e-3, "{held}, {free}");
     assert!(stretch.abs() < 1e-3, "{stretch}");
 }
+
+/// `ghost_penalty` and `ghost_fill` reach the Newton options on a grid;
+/// other meshes, a fill without a penalty and out-of-range values are
+/// refused with the key's place.
+#[test]
+fn ghost_penalty_keys() {
+    let collapse = include_str!("../../../scenes/coombs2020_collapse.toml");
+    let build = |text: &str, sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let (scene, src) = scene::parse(text, "c.toml", &sets).unwrap();
+        Problem::<2>::build(&scene, &src, scene.solver.padding()).map_err(|e| e.to_string())
+    };
+    assert_eq!(
+        build(collapse, &[]).unwrap().newton.ghost,
+        mpm_solver::GhostPenalty::OFF
+    );
+    let p = build(collapse, &["solver.ghost_penalty=0.01"]).unwrap();
+    assert_eq!(p.newton.ghost, mpm_solver::GhostPenalty::new(0.01));
+    let p = build(
+        collapse,
+        &["solver.ghost_penalty=0.1", "solver.ghost_fill=0.25"],
+    )
+    .unwrap();
+    assert_eq!(p.newton.ghost.factor, 0.1);
+    assert_eq!(p.newton.ghost.fill, 0.25);
+    for (sets, expected) in [
+        (
+            &["solver.ghost_fill=0.3"][..],
+            "solver `ghost_fill` applies with `ghost_penalty`",
+        ),
+        (
+            &["solver.ghost_penalty=-1"][..],
+            "solver `ghost_penalty` is a multiple of the law's 2μ, >= 0",
+        ),
+        (
+            &["solver.ghost_penalty=0.01", "solver.ghost_fill=1.5"][..],
+            "solver `ghost_fill` is a fraction of a cell's volume in (0, 1]",
+        ),
+    ] {
+        let e = build(collapse, sets).unwrap_err();
+        assert!(e.contains(expected), "{e}");
+        assert!(e.contains("c.toml:"), "{e}");
+    }
+    let annulus = include_str!("../../../scenes/coombs2020_annulus.toml");
+    let e = build(annulus, &["solver.ghost_penalty=0.01"]).unwrap_err();
+    assert!(
+        e.contains("solver `ghost_penalty` acts on the faces of a regular grid's cells"),
+        "{e}"
+    );
+}

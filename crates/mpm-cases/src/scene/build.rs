@@ -1873,6 +1873,46 @@ impl<const D: usize> Problem<D> {
             defaults.weak_node_stiffness,
             "weak_node_stiffness",
         )?;
+        let ghost = match (&s.ghost_penalty, &s.ghost_fill) {
+            (None, Some(f)) => {
+                return Err(src.at(f, "solver `ghost_fill` applies with `ghost_penalty`"));
+            }
+            (None, None) => mpm_solver::GhostPenalty::OFF,
+            (Some(g), fill) => {
+                if !(g.get_ref().is_finite() && *g.get_ref() >= 0.0) {
+                    return Err(src.at(
+                        g,
+                        format!(
+                            "solver `ghost_penalty` is a multiple of the law's 2μ, >= 0 (0 disables it), got {}",
+                            g.get_ref()
+                        ),
+                    ));
+                }
+                if *g.get_ref() > 0.0 && !matches!(mesh, SceneMesh::Grid(_)) {
+                    return Err(src.at(
+                        g,
+                        "solver `ghost_penalty` acts on the faces of a regular grid's cells ([mesh] kind = \"grid\")",
+                    ));
+                }
+                let fill = match fill {
+                    None => mpm_solver::GhostPenalty::OFF.fill,
+                    Some(f) if *f.get_ref() > 0.0 && *f.get_ref() <= 1.0 => *f.get_ref(),
+                    Some(f) => {
+                        return Err(src.at(
+                            f,
+                            format!(
+                                "solver `ghost_fill` is a fraction of a cell's volume in (0, 1], got {}",
+                                f.get_ref()
+                            ),
+                        ));
+                    }
+                };
+                mpm_solver::GhostPenalty {
+                    factor: *g.get_ref(),
+                    fill,
+                }
+            }
+        };
         let linear = {
             let mut iterative = mpm_solver::IterativeOptions::default();
             if let Some(t) = &s.linear_tolerance {
@@ -2104,6 +2144,7 @@ impl<const D: usize> Problem<D> {
                 linear,
                 weak_node_threshold,
                 weak_node_stiffness,
+                ghost,
                 ..NewtonOptions::default()
             },
             variant,
@@ -2829,6 +2870,8 @@ fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>
         ),
         ("weak_node_threshold", span(&s.weak_node_threshold)),
         ("weak_node_stiffness", span(&s.weak_node_stiffness)),
+        ("ghost_penalty", span(&s.ghost_penalty)),
+        ("ghost_fill", span(&s.ghost_fill)),
     ];
     if let Some((key, Some(at))) = implicit_keys.into_iter().find(|(_, at)| at.is_some()) {
         return Err(src.error(

@@ -589,6 +589,15 @@ pub struct SolverSpec {
     /// 0 disables).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub weak_node_stiffness: Option<Spanned<f64>>,
+    /// Implicit, grid meshes: the ghost penalty on the faces of cut cells
+    /// as a multiple γ of the law's 2μ
+    /// ([`mpm_solver::NewtonOptions::ghost`]; default 0, off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ghost_penalty: Option<Spanned<f64>>,
+    /// Implicit, with `ghost_penalty`: a cell is cut when its points'
+    /// volume is below this fraction of its own (default 0.5).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ghost_fill: Option<Spanned<f64>>,
     /// Explicit: the simulated time the run ends at (s).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub end_time: Option<Spanned<f64>>,
@@ -697,6 +706,8 @@ impl Default for SolverSpec {
             max_direct_dofs: None,
             weak_node_threshold: None,
             weak_node_stiffness: None,
+            ghost_penalty: None,
+            ghost_fill: None,
             end_time: None,
             cfl: None,
             time_step: None,
