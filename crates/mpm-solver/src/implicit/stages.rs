@@ -91,6 +91,11 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 ))?
                 .mu;
             let g = self.options.ghost;
+            if !(g.factor.is_finite() && g.fill > 0.0 && g.fill <= 1.0) {
+                return Err(SolverError::Ghost(
+                    "its factor must be finite and its fill in (0, 1]",
+                ));
+            }
             ghost.build(
                 grid,
                 &points.position,
@@ -113,15 +118,14 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 .assign(&self.mesh, input, &mut self.patches.assignment)?;
             self.patches.build(sys);
             sys.build_patch_neighbours(&self.patches);
-            if !ghost.is_empty() {
-                sys.extend_neighbours(|w, push| ghost.partners(w, push));
-            }
-            self.patches.build_placement(sys);
         } else {
             sys.build_neighbours();
-            if !ghost.is_empty() {
-                sys.extend_neighbours(|w, push| ghost.partners(w, push));
-            }
+        }
+        if !ghost.is_empty() {
+            sys.extend_neighbours(|w, push| ghost.partners(w, push));
+        }
+        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+            self.patches.build_placement(sys);
         }
         let (support, stiffness) = gather::support_weights(sys, volumes);
         let max = |x: &[f64]| x.iter().copied().fold(0.0, f64::max);
