@@ -35,7 +35,7 @@ use mpm_mesh::{BoxMesh, PatchMesh, QuadraticMesh, RegularGrid};
 use mpm_solver::{
     FBar, FPatch, ImplicitSolver, LoadStepping, LockingTreatment, MaterialPoints, NewtonOptions,
     NoLocking, NoUpdate, NodalConstraints, Parts, PreviouslyConverged, SolverError,
-    UpdatedLagrangian,
+    UpdatedLagrangian, stages::ghost::GhostPenalty,
 };
 
 use crate::variant::FormulationKind;
@@ -216,6 +216,14 @@ fn newton(weak_node_threshold: f64) -> NewtonOptions {
     }
 }
 
+/// The ghost penalty of the grid runs whose body moves into empty cells
+/// ([`Traction::grid_newton`]): 0.01 · 2μ on the faces next to cells
+/// their points fill below half. It acts on each step's increment, so it
+/// makes a response depend on the number of steps at its own order, which
+/// falls with refinement (`docs/src/theory/locking.md`, "Fringe cells and
+/// the ghost penalty").
+pub const GRID_GHOST: GhostPenalty = GhostPenalty::new(0.01);
+
 /// How a lattice run carries the traction and measures the tip.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Traction {
@@ -240,31 +248,32 @@ impl Traction {
     }
 
     /// The study's Newton controls ([`newton`]) with the scheme's
-    /// fringe-node rules.
-    fn newton(self) -> NewtonOptions {
-        NewtonOptions {
-            weak_node_stiffness: self.weak_node_stiffness(),
-            ..newton(self.weak_node_threshold())
-        }
+    /// fringe-node rules, the same on every mesh: the weak-node rules at
+    /// their defaults (the threshold 0 for
+    /// [`Traction::EdgeGaussPoints`]). A grid run adds [`GRID_GHOST`]
+    /// when the body moves into empty cells ([`Traction::grid_newton`]).
+    pub fn newton(self) -> NewtonOptions {
+        newton(self.weak_node_threshold())
     }
 
-    /// The weak-node stiffness rule of the run: the default where the body
-    /// stays in the cells it starts in; 10⁻³ instead of 10⁻⁴ when it moves
-    /// into empty cells. There a point of the lattice's fringe that has
-    /// just crossed into an empty cell reaches the cell's far nodes with
-    /// bilinear gradients proportional to its distance from the cell
-    /// edges, (1 − ξ)/h, and nothing else reaches them; left free, these
-    /// nodes of stiffness weight 10⁻⁴ to 10⁻³ of the largest receive
-    /// increments large enough to strain the point beyond the admissible
-    /// ‖ΔF‖ (standard MPM at ν = 0.3 and F-bar at ν = 0.4999 on the grid at
-    /// n = 32 failed so at the load factor 0.5 to 0.6, with 10, 20 or 40
-    /// steps, at points of the loaded column's lower corner). Linear
-    /// simplices' gradients do not depend on where the point is in its
-    /// element, so on triangles the rule holds no node of a real point.
-    fn weak_node_stiffness(self) -> f64 {
+    /// The Newton controls of a grid run: [`Traction::newton`], and for
+    /// [`Traction::BoundaryColumn`] the ghost penalty [`GRID_GHOST`]. There
+    /// a point of the lattice's fringe that has just crossed into an empty
+    /// cell reaches the cell's far nodes with bilinear gradients
+    /// proportional to its distance from the cell edges, and nothing else
+    /// reaches them: a near-mechanism of the stiffness, along which Newton
+    /// corrections strained the point beyond the admissible ‖ΔF‖ (9 of 36
+    /// full-load runs failed so without the penalty, none with it;
+    /// `docs/src/theory/locking.md`, "Fringe cells and the ghost
+    /// penalty"). Linear simplices' gradients do not depend on where the
+    /// point is in its element, so the triangle runs need no penalty.
+    pub fn grid_newton(self) -> NewtonOptions {
         match self {
-            Traction::EdgeGaussPoints => NewtonOptions::default().weak_node_stiffness,
-            Traction::BoundaryColumn => 1e-3,
+            Traction::EdgeGaussPoints => self.newton(),
+            Traction::BoundaryColumn => NewtonOptions {
+                ghost: GRID_GHOST,
+                ..self.newton()
+            },
         }
     }
 
@@ -512,11 +521,30 @@ fn column_loads(cook: &Cook, step: f64, position: &[Vector2<f64>]) -> Vec<(usize
 /// Cook's membrane on a regular grid of spacing 48/`n` covering the
 /// membrane and the room it deforms into ([`background`]), 2×2 lattice
 /// points per cell kept inside the membrane, with the treatment
-/// `locking`, the load carried by `traction`.
+/// `locking`, the load carried by `traction`, the Newton controls
+/// [`Traction::grid_newton`].
 ///
 /// # Errors
 /// A [`SolverError`] when the run fails.
 pub fn grid<K>(cook: &Cook, locking: K, traction: Traction) -> Result<CookResult, SolverError>
+where
+    K: LockingTreatment<2, RegularGrid<2>>,
+{
+    grid_with(cook, locking, traction, traction.grid_newton())
+}
+
+/// [`grid`] with the Newton controls `options` (to compare fringe
+/// treatments: the ghost penalty off or at another factor, other
+/// weak-node rules).
+///
+/// # Errors
+/// A [`SolverError`] when the run fails.
+pub fn grid_with<K>(
+    cook: &Cook,
+    locking: K,
+    traction: Traction,
+    options: NewtonOptions,
+) -> Result<CookResult, SolverError>
 where
     K: LockingTreatment<2, RegularGrid<2>>,
 {
@@ -528,7 +556,6 @@ where
     let nodes = (0..count).map(|v| grid.node_position(v).unwrap_or_else(|_| Vector2::zeros()));
     let c = clamp(nodes, count, h);
     let law = HenckyElastic::new(YOUNG, cook.nu)?;
-    let options = traction.newton();
     with_formulation!(cook.formulation, F, {
         let solver: ImplicitSolver<2, Parts<LinearMpm, F, _, K, NoUpdate, _>> =
             ImplicitSolver::new(LinearMpm, grid, law, locking, NoUpdate, c, options);

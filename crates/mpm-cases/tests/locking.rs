@@ -78,14 +78,14 @@ fn the_full_load_runs_on_background_meshes() {
     assert!((grid3 - fbar3).abs() < 0.1 * fbar3, "{grid3} {fbar3}");
 }
 
-/// The grid's finest full-load runs that failed with the default
-/// fringe-node rule (standard MPM at ν = 0.3, F-bar at ν = 0.4999, both
-/// at the load factor 0.5 to 0.6: a lattice point alone in a cell it has
-/// just entered strained beyond the admissible ‖ΔF‖ by its far nodes)
-/// complete with the background runs' rule (`Traction::BoundaryColumn`):
-/// at ν = 0.3 F-bar changes standard MPM's tip by less than 5 %, and at
-/// ν = 0.4999 F-bar agrees with F-patch on the background triangles of
-/// the same spacing within 5 %.
+/// The grid's finest full-load runs that failed with the weak-node rules
+/// alone (standard MPM at ν = 0.3, F-bar at ν = 0.4999, both at the load
+/// factor 0.5 to 0.6: a lattice point alone in a cell it has just entered
+/// strained beyond the admissible ‖ΔF‖ by its far nodes) complete with
+/// the grid runs' ghost penalty (`Traction::grid_newton`): at ν = 0.3
+/// F-bar changes standard MPM's tip by less than 5 %, and at ν = 0.4999
+/// F-bar agrees with F-patch on the background triangles of the same
+/// spacing within 5 %.
 #[test]
 fn the_finest_grid_completes_the_full_load() {
     use mpm_cases::locking::{Traction, grid, triangles_background};
@@ -244,11 +244,115 @@ fn both_formulations_reach_the_same_membrane_in_any_number_of_steps() {
                 "run {k}, {steps} steps: ul {a} against pc {b}"
             );
             // Geometric nonlinearity at a load of 0.01: 1e-5 of the tip.
+            // The grid runs' ghost penalty acts on each step's increment,
+            // so their tips depend on the steps at the penalty's own
+            // order (`the_ghost_penalty_change_falls_with_refinement_and_steps`).
+            if k >= 2 {
+                continue;
+            }
             assert!(
                 (b - one[k]).abs() < 1e-4 * b.abs(),
                 "run {k}: {steps} steps {b} against 1 step {}",
                 one[k]
             );
         }
+    }
+}
+
+/// The grid runs' ghost penalty is consistent: on a linear response
+/// (small load) its change of the tip falls as the grid is refined and as
+/// the steps are made smaller. It acts on each step's increment and is
+/// forgotten with the grid, so a step leaves the out-of-balance G Δu_k
+/// to the next, whose increment then tends to the unpenalised one; with
+/// K stiff on the penalised modes the change would fall as 1/N, but the
+/// modes are the fringe's near-mechanisms, where the penalty outweighs
+/// the stiffness, and it falls more slowly (measured 1.78 %, 1.37 %,
+/// 0.31 % in 1, 2, 10 steps for standard MPM at n = 4;
+/// `docs/src/theory/locking.md`, "Fringe cells and the ghost penalty").
+#[test]
+fn the_ghost_penalty_change_falls_with_refinement_and_steps() {
+    use mpm_cases::locking::{Traction, grid, grid_with};
+    use mpm_solver::{FBar, NoLocking};
+    let column = Traction::BoundaryColumn;
+    const STEPS: [usize; 3] = [1, 2, 10];
+    const CELLS: [usize; 3] = [4, 8, 16];
+    for fbar in [false, true] {
+        let cook = |n, steps| Cook {
+            nu: 0.4,
+            load: 0.01,
+            steps,
+            n,
+            formulation: FormulationKind::Pc,
+        };
+        let run = |n, steps, options| {
+            let result = if fbar {
+                grid_with(&cook(n, steps), FBar::default(), column, options)
+            } else {
+                grid_with(&cook(n, steps), NoLocking, column, options)
+            };
+            result.unwrap().tip
+        };
+        // change[s][c]: the relative change of the tip in STEPS[s] steps
+        // on CELLS[c] cells.
+        let mut change = [[0.0; 3]; 3];
+        for (s, steps) in STEPS.into_iter().enumerate() {
+            for (c, n) in CELLS.into_iter().enumerate() {
+                let free = run(n, steps, column.newton());
+                let tip = run(n, steps, column.grid_newton());
+                let default = if fbar {
+                    grid(&cook(n, steps), FBar::default(), column)
+                } else {
+                    grid(&cook(n, steps), NoLocking, column)
+                };
+                assert_eq!(tip, default.unwrap().tip, "the grid runs use the penalty");
+                change[s][c] = ((tip - free) / free).abs();
+                println!(
+                    "F-bar {fbar}, {steps} steps, n = {n}: unpenalised {free:.6e}, penalised \
+                     {tip:.6e}, change {:.3} %",
+                    100.0 * change[s][c]
+                );
+            }
+        }
+        assert!(change[0][0] > 1e-3, "the penalty must act: {change:?}");
+        for s in 0..3 {
+            for c in 0..3 {
+                if c > 0 {
+                    assert!(change[s][c] < change[s][c - 1], "refinement: {change:?}");
+                }
+                if s > 0 {
+                    assert!(change[s][c] < change[s - 1][c], "steps: {change:?}");
+                }
+            }
+        }
+    }
+}
+
+/// The grid full-load runs that failed without the ghost penalty (F-bar at
+/// ν = 0.4999, n = 16 in 10 steps and n = 32 in 40 steps: 9 of 36 runs
+/// of the load-step study failed so, none with the penalty) complete with
+/// it, their tips within 5 % of F-patch on the background triangles of the
+/// same spacing.
+#[test]
+fn the_ghost_penalty_completes_the_failing_grid_runs() {
+    use mpm_cases::locking::{Traction, grid, triangles_background};
+    use mpm_solver::{FBar, FPatch};
+    for (n, steps) in [(16, 10), (32, 40)] {
+        let cook = |steps| Cook {
+            nu: 0.4999,
+            load: 100.0,
+            steps,
+            n,
+            formulation: FormulationKind::Pc,
+        };
+        let fbar = grid(&cook(steps), FBar::default(), Traction::BoundaryColumn).unwrap();
+        let fpatch = triangles_background(&cook(10), FPatch::new).unwrap();
+        println!(
+            "n = {n}, {steps} steps: grid F-bar {:.4} ({} iterations), F-patch {:.4}",
+            fbar.tip, fbar.iterations, fpatch.tip
+        );
+        assert!(
+            (fbar.tip - fpatch.tip).abs() < 0.05 * fpatch.tip,
+            "{fbar:?} {fpatch:?}"
+        );
     }
 }
