@@ -88,6 +88,20 @@ pub trait LogStrainLaw: Send + Sync {
         None
     }
 
+    /// The small-strain shear modulus $\mu$ at a point of internal
+    /// variables `history`: the law's own ([`Self::elasticity`]) unless the
+    /// law holds several materials ([`crate::MaterialSet`]), whose points
+    /// each have their material's. Stabilisations that scale with the
+    /// stiffness take it per point (the implicit solver's ghost penalty,
+    /// `mpm_solver::stages::ghost`), so a soft body's cut cells are not
+    /// penalised at a stiff body's modulus. `None` when the law has no
+    /// elastic constants.
+    #[inline]
+    fn point_shear_modulus(&self, history: &Self::History) -> Option<f64> {
+        let _ = history;
+        self.elasticity().map(|e| e.mu)
+    }
+
     /// The stored (recoverable) energy per unit reference volume of the
     /// elastic Hencky strain with principal values `elastic_strain`, for
     /// energy balances; plastic dissipation is not included. `None` when

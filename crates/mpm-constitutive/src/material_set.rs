@@ -125,6 +125,12 @@ impl<L: LogStrainLaw> LogStrainLaw for MaterialSet<L> {
         self.law(history.material)
             .loading_tangent(trial, &history.inner, &untagged(state))
     }
+
+    #[inline]
+    fn point_shear_modulus(&self, history: &Self::History) -> Option<f64> {
+        self.law(history.material)
+            .point_shear_modulus(&history.inner)
+    }
 }
 
 /// The member law's state of a set's state (the tag removed).
@@ -168,7 +174,15 @@ mod tests {
                 set.algorithmic_tangent(&trial, &h, &got),
                 law.algorithmic_tangent(&trial, &h.inner, &want)
             );
+            // Each point's shear modulus is its material's: E / (2 (1 + ν)).
+            let mu = law.elasticity().mu;
+            assert_eq!(set.point_shear_modulus(&h), Some(mu));
         }
+        let stiff = set.point_shear_modulus(&Tagged::new(1, Default::default()));
+        assert!(
+            stiff.is_some_and(|m| (m - 5e7 / 2.4).abs() < 1e-9 * m),
+            "{stiff:?}"
+        );
         // The three differ: yielding in the first and third only.
         let yielded: Vec<bool> = (0..3)
             .map(|k| {

@@ -83,13 +83,15 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 .mesh
                 .regular_grid()
                 .ok_or(SolverError::Ghost("it is defined on regular grids only"))?;
-            let mu = self
-                .law
-                .elasticity()
-                .ok_or(SolverError::Ghost(
+            // Each point's shear modulus: its material's under a law of
+            // several materials.
+            let law = &self.law;
+            let history = &points.history;
+            if history.iter().any(|h| law.point_shear_modulus(h).is_none()) {
+                return Err(SolverError::Ghost(
                     "it scales with the law's shear modulus, and this law gives none",
-                ))?
-                .mu;
+                ));
+            }
             let g = self.options.ghost;
             if !(g.factor.is_finite() && g.fill > 0.0 && g.fill <= 1.0) {
                 return Err(SolverError::Ghost(
@@ -101,7 +103,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 &points.position,
                 volumes,
                 sys,
-                g.factor * 2.0 * mu,
+                |p| g.factor * 2.0 * law.point_shear_modulus(&history[p]).unwrap_or(0.0),
                 g.fill,
             )?;
         } else {

@@ -25,8 +25,10 @@
 //!
 //! where $[\![\partial_n\Delta\mathbf u]\!]$ is the jump of the normal
 //! derivative of the cells' multilinear interpolant of the nodal
-//! increments across $F$, $h_F$ the spacing normal to $F$, $\mu$ the law's
-//! shear modulus and $\gamma$ [`GhostPenalty::factor`]. The tangential
+//! increments across $F$, $h_F$ the spacing normal to $F$, $\mu$ the
+//! largest shear modulus of the two cells' points (the law's
+//! `point_shear_modulus`: one value for one material, each point's own
+//! under a `MaterialSet`) and $\gamma$ [`GhostPenalty::factor`]. The tangential
 //! derivatives of a continuous interpolant do not jump, so this is the
 //! jump of the whole gradient. It vanishes for every increment that is
 //! linear in space (a patch test, [`tests`]), so it does not change the
@@ -114,6 +116,8 @@ pub struct GhostFaces {
     pub node_faces: Vec<u32>,
     /// Volume of the points per cell (scratch).
     fill: Vec<f64>,
+    /// Largest modulus of the points per cell (scratch).
+    cell_modulus: Vec<f64>,
     /// (lower cell id, normal axis) of each face (scratch).
     faces: Vec<(usize, usize)>,
 }
@@ -139,9 +143,12 @@ impl GhostFaces {
     }
 
     /// Finds the penalised faces of the step on `grid` from the points at
-    /// the start of the step and computes their stiffness, `modulus` =
-    /// $\gamma\,2\mu$. Faces with a node outside the active set (possible
-    /// with bases whose stencils are not the cell's nodes) are left out.
+    /// the start of the step and computes their stiffness; `modulus(p)` is
+    /// $\gamma\,2\mu_p$ at point `p`, and a face takes the largest of its two
+    /// cells' points (one value for a law of one material; with several,
+    /// a soft body's faces are not penalised at a stiff body's modulus).
+    /// Faces with a node outside the active set (possible with bases whose
+    /// stencils are not the cell's nodes) are left out.
     ///
     /// # Errors
     /// A [`MeshError`] for a point outside the grid.
@@ -151,7 +158,7 @@ impl GhostFaces {
         position: &[SVector<f64, D>],
         volume: &[f64],
         sys: &StepSystem<D>,
-        modulus: f64,
+        modulus: impl Fn(usize) -> f64,
         fill: f64,
     ) -> Result<(), MeshError> {
         self.clear();
@@ -159,9 +166,12 @@ impl GhostFaces {
         self.stride = 3 * half;
         self.fill.clear();
         self.fill.resize(grid.cell_count(), 0.0);
-        for (x, &v) in position.iter().zip(volume) {
+        self.cell_modulus.clear();
+        self.cell_modulus.resize(grid.cell_count(), 0.0);
+        for (p, (x, &v)) in position.iter().zip(volume).enumerate() {
             let cell = grid.cell_id(grid.cell_containing(x)?)?;
             self.fill[cell] += v;
+            self.cell_modulus[cell] = self.cell_modulus[cell].max(modulus(p));
         }
         let h = grid.spacing();
         let cell_volume: f64 = h.iter().product();
@@ -198,6 +208,10 @@ impl GhostFaces {
         let faces = std::mem::take(&mut self.faces);
         'faces: for &(lower, a) in &faces {
             let base = grid.cell_index(lower)?;
+            let mut upper = base;
+            upper[a] += 1;
+            let face_modulus =
+                self.cell_modulus[lower].max(self.cell_modulus[grid.cell_id(upper)?]);
             for (slot, corner) in corners.iter_mut().enumerate() {
                 // Slot = layer · 2^(D−1) + face corner; the corner's bits
                 // run over the axes other than `a`.
@@ -228,8 +242,9 @@ impl GhostFaces {
                         .filter(|&i| i != a)
                         .map(|i| h[i] * mass(bv[i], bw[i]))
                         .product();
-                    self.weights
-                        .push(modulus * layer_factor[cv] * layer_factor[cw] / h[a] * tangential);
+                    self.weights.push(
+                        face_modulus * layer_factor[cv] * layer_factor[cw] / h[a] * tangential,
+                    );
                 }
             }
         }
@@ -385,9 +400,53 @@ mod tests {
         let sys = all_active(grid);
         let mut faces = GhostFaces::default();
         faces
-            .build(grid, &x, &v, &sys, 3.0, 0.9)
+            .build(grid, &x, &v, &sys, |_| 3.0, 0.9)
             .unwrap_or_else(|e| panic!("{e}"));
         faces
+    }
+
+    /// Each face takes the larger modulus of its two cells' points: two
+    /// materials side by side (moduli 1 and 5 split at x = 1.75, inside a
+    /// column of cells) give faces of 1 in the soft part, 5 in the stiff
+    /// part and 5 on the faces between them.
+    #[test]
+    fn a_face_takes_the_larger_modulus_of_its_cells() {
+        let grid = RegularGrid::new(Vector2::zeros(), Vector2::new(0.5, 0.5), [7, 5])
+            .unwrap_or_else(|e| panic!("{e}"));
+        let (x, v) = lattice(&grid, 2, |x| (x - Vector2::new(1.7, 1.2)).norm() < 1.3);
+        let sys = all_active(&grid);
+        let soft = |p: usize| if x[p][0] < 1.75 { 1.0 } else { 5.0 };
+        let mut unit = GhostFaces::default();
+        unit.build(&grid, &x, &v, &sys, |_| 1.0, 0.9)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut mixed = GhostFaces::default();
+        mixed
+            .build(&grid, &x, &v, &sys, soft, 0.9)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(unit.nodes, mixed.nodes);
+        let mut cell_max = vec![0.0f64; grid.cell_count()];
+        for (p, y) in x.iter().enumerate() {
+            let c = grid
+                .cell_id(grid.cell_containing(y).unwrap_or_else(|e| panic!("{e}")))
+                .unwrap_or_else(|e| panic!("{e}"));
+            cell_max[c] = cell_max[c].max(soft(p));
+        }
+        let m2 = unit.stride * unit.stride;
+        let mut seen = [false; 2];
+        for (k, &(lower, a)) in mixed.faces.iter().enumerate() {
+            let mut upper = grid.cell_index(lower).unwrap_or_else(|e| panic!("{e}"));
+            upper[a] += 1;
+            let upper = grid.cell_id(upper).unwrap_or_else(|e| panic!("{e}"));
+            let want = cell_max[lower].max(cell_max[upper]);
+            seen[usize::from(want > 1.0)] = true;
+            for (w, u) in mixed.weights[k * m2..(k + 1) * m2]
+                .iter()
+                .zip(&unit.weights[k * m2..(k + 1) * m2])
+            {
+                assert!((w - want * u).abs() <= 1e-12 * u.abs(), "face {k}: {w} {u}");
+            }
+        }
+        assert_eq!(seen, [true, true], "faces of both moduli");
     }
 
     /// The penalty vanishes for every linear increment (patch test, to
