@@ -328,8 +328,10 @@ fn the_ghost_penalty_change_falls_with_refinement_and_steps() {
 }
 
 /// The grid full-load runs that failed without the ghost penalty (F-bar at
-/// ν = 0.4999, n = 16 in 10 steps and n = 32 in 40 steps: 9 of 36 runs
-/// of the load-step study failed so, none with the penalty) complete with
+/// ν = 0.4999, n = 16 in 10 steps and n = 32 in 40 steps, with the
+/// weak-node stiffness rule 10⁻³ the study used before; the load-step
+/// study of `cargo xtask reproduce locking` fails 11 of 36 runs without the
+/// penalty and none with it) complete with
 /// it, their tips within 5 % of F-patch on the background triangles of the
 /// same spacing.
 #[test]
