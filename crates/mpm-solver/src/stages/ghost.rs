@@ -283,15 +283,19 @@ impl GhostFaces {
         }
     }
 
+    /// Each face's active nodes and its `stride²` stiffness weights.
+    fn face_blocks(&self) -> impl Iterator<Item = (&[u32], &[f64])> {
+        let m = self.stride;
+        self.nodes
+            .chunks_exact(m)
+            .zip(self.weights.chunks_exact(m * m))
+    }
+
     /// Adds the penalty's force $K\Delta\mathbf u$ to `force` (both per
     /// active dof, `D · v + i`).
     pub fn add_force<const D: usize>(&self, du: &[f64], force: &mut [f64]) {
         let m = self.stride;
-        for (nodes, k) in self
-            .nodes
-            .chunks_exact(m)
-            .zip(self.weights.chunks_exact(m * m))
-        {
+        for (nodes, k) in self.face_blocks() {
             for (a, &v) in nodes.iter().enumerate() {
                 for (b, &w) in nodes.iter().enumerate() {
                     let kab = k[a * m + b];
@@ -307,11 +311,7 @@ impl GhostFaces {
     /// neighbour lists hold the face partners, [`Self::partners`]).
     pub fn add_stiffness<const D: usize>(&self, sys: &StepSystem<D>, values: &mut [f64]) {
         let m = self.stride;
-        for (nodes, k) in self
-            .nodes
-            .chunks_exact(m)
-            .zip(self.weights.chunks_exact(m * m))
-        {
+        for (nodes, k) in self.face_blocks() {
             for (b, &w) in nodes.iter().enumerate() {
                 let w = w as usize;
                 let nbs = &sys.nb[sys.nb_ptr[w]..sys.nb_ptr[w + 1]];
