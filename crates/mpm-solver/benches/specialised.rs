@@ -21,13 +21,14 @@
 //! the generic solver's public stages (`update_material_points`,
 //! `assemble_internal_force`, `update_tangents`, `assemble_stiffness`)
 //! against the kernel's two passes, and between them variants of the
-//! kernel that add back one thing the generic path does: the
-//! excessive-increment test (`checked_points_pass`), full 9 × 9 weighted
-//! tangents (`checked_full_points_pass`), responses stored as
-//! `Option<Response>` with the tangents in a second pass
-//! (`stored_points_pass`), and the node pass reading full tangents
-//! (`full_tensor_nodes_pass`). Each variant is checked to give the
-//! kernel's result bit for bit.
+//! kernel that add back one thing the generic path does or did: the
+//! excessive-increment test (`checked_points_pass`), responses stored
+//! with the tangents in a second pass (`two_sweep_points_pass`; as
+//! `Option<Response>` and with the test, `stored_points_pass`), and full
+//! 9 × 9 weighted tangents, which the generic path stored until it kept
+//! the D⁴ components in use (`checked_full_points_pass`, and the node pass
+//! reading them, `full_tensor_nodes_pass`). Each variant is checked to give
+//! the kernel's result bit for bit.
 //!
 //! Run: `cargo bench -p mpm-solver --bench specialised`; numbers are
 //! recorded in `docs/src/benchmarks/zero_cost.md`.
@@ -411,7 +412,9 @@ impl<const D: usize> Specialised<D> {
                 // compiler does not elide.
                 let response = update(&this.law, &this.delta_f(p), &points.f[p], &state);
                 let r = response.as_ref().map_err(|e| *e)?;
-                if CHECK && r.delta_f.norm().max(r.delta_f_inv.norm()) > limit {
+                if CHECK
+                    && r.delta_f.norm_squared().max(r.delta_f_inv.norm_squared()) > limit * limit
+                {
                     // Reported as a constitutive error: the test is here
                     // to be timed.
                     return Err(ConstitutiveError::NonPositiveJacobian {
@@ -468,11 +471,12 @@ impl<const D: usize> Specialised<D> {
             })
     }
 
-    /// Pass 1 organised as the generic solver organises it, for the stage
-    /// comparison only: the excessive-increment test, every point's
-    /// response stored as `Option<Response>`, then the tangents computed
-    /// from the stored responses in a second parallel pass and stored as
-    /// full weighted 9 × 9 tensors. What it leaves out of the generic
+    /// Pass 1 organised as the generic solver organised it before it kept
+    /// the D⁴ tangent components only, for the stage comparison: the
+    /// excessive-increment test, every point's response stored as
+    /// `Option<Response>`, then the tangents computed from the stored
+    /// responses in a second parallel pass and stored as full weighted
+    /// 9 × 9 tensors. What it leaves out of the generic
     /// stages is the locking hook and the formulation's static dispatch
     /// (both should cost nothing) and the lowest-failure reduction.
     fn points_pass_stored(
@@ -495,7 +499,9 @@ impl<const D: usize> Specialised<D> {
                 };
                 match update(&this.law, &this.delta_f(p), &points.f[p], &state) {
                     Ok(r) => {
-                        if r.delta_f.norm().max(r.delta_f_inv.norm()) > limit {
+                        if r.delta_f.norm_squared().max(r.delta_f_inv.norm_squared())
+                            > limit * limit
+                        {
                             return Err(ConstitutiveError::NonPositiveJacobian {
                                 which: "ΔF",
                                 det: f64::NAN,
@@ -703,8 +709,8 @@ fn write_restricted<const D: usize>(t: &mut Restricted<D>, a: &Tensor4, volume: 
     }
 }
 
-/// The generic solver's store: full weighted 9 × 9 tensors (for the stage
-/// comparison).
+/// Full weighted 9 × 9 tensors, the generic solver's former store (for
+/// the stage comparison).
 struct Full<'a>(&'a [Tensor4]);
 
 impl<const D: usize> Tangents<D> for Full<'_> {

@@ -43,7 +43,6 @@ pub use options::{FirstTangent, MAX_BACKTRACKS, NewtonOptions};
 pub use report::{CutStep, FreeStiffness, StageTimes, StepError, StepReport};
 
 use mpm_constitutive::Response;
-use mpm_constitutive::tensor::Tensor4;
 use nalgebra::{Matrix3, SVector};
 
 use crate::error::StepFailure;
@@ -56,6 +55,7 @@ fn lap(clock: Instant) -> f64 {
 }
 use crate::parts::{PointsOf, SolverParts};
 use crate::stages::convergence::{self, NewtonMonitor, Verdict};
+use crate::stages::gather::PointTangent;
 use crate::stages::ghost::GhostFaces;
 use crate::stages::patch::PatchSystem;
 use crate::stages::system::StepSystem;
@@ -70,7 +70,11 @@ struct Iterate<const D: usize, H> {
     values: Vec<f64>,
     responses: Vec<Option<Response<H>>>,
     stress_w: Vec<Matrix3<f64>>,
-    tangent_w: Vec<Tensor4>,
+    /// Per point, the weighted tangent's components in use.
+    tangent_w: Vec<PointTangent<D>>,
+    /// Per point, $\|T_p\|_F$ of the full weighted tangent, when the
+    /// last tangent pass was asked for it (the rounding-noise bound).
+    tangent_norms: Vec<f64>,
     mapped: Vec<SVector<f64, D>>,
     increments: Vec<Matrix3<f64>>,
     /// `values` holds a stiffness assembled on the current system.
@@ -88,6 +92,7 @@ impl<const D: usize, H> Default for Iterate<D, H> {
             responses: Vec::new(),
             stress_w: Vec::new(),
             tangent_w: Vec::new(),
+            tangent_norms: Vec::new(),
             mapped: Vec::new(),
             increments: Vec::new(),
             stiffness_assembled: false,
@@ -248,13 +253,15 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 Verdict::Continue => {}
             }
             let clock = Instant::now();
-            self.update_tangents(points)
+            // The first iteration's tangents also give the rounding noise.
+            let first = iteration == 0;
+            self.update_tangents_with::<false>(points, first)
                 .map_err(|cause| retry(cause, &monitor))?;
-            if iteration == 0 {
+            if first {
                 monitor.set_rounding_noise(convergence::rounding_noise(
                     &self.system,
                     self.force_gradients(),
-                    &self.it.tangent_w,
+                    &self.it.tangent_norms,
                 ));
             }
             times.tangent += lap(clock);

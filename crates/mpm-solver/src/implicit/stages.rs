@@ -3,7 +3,6 @@
 //! [`crate::stages`], plus the constitutive update and tangents, which
 //! depend on the formulation.
 
-use mpm_constitutive::tensor::{Tensor4, idx};
 use mpm_constitutive::{ConsistentTangent, ConstitutiveError, LogStrainLaw, MaterialState, update};
 use nalgebra::{Matrix3, SVector};
 use rayon::prelude::*;
@@ -272,11 +271,13 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 };
                 match update(law, &delta_f, &points.f[p], &state) {
                     Ok(r) => {
-                        let norm = r.delta_f.norm().max(r.delta_f_inv.norm());
-                        if norm > limit {
+                        // Squared norms: the square root only for the
+                        // report.
+                        let squared = r.delta_f.norm_squared().max(r.delta_f_inv.norm_squared());
+                        if squared > limit * limit {
                             return Some(StepFailure::ExcessiveIncrement {
                                 point: p,
-                                norm,
+                                norm: squared.sqrt(),
                                 limit,
                             });
                         }
@@ -345,48 +346,66 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// Stage 4c: the formulation's consistent tangent at every point,
     /// weighted by its integration volume.
     pub fn update_tangents(&mut self, points: &PointsOf<D, P>) -> Result<(), StepFailure> {
-        self.update_tangents_with::<false>(points)
+        self.update_tangents_with::<false>(points, false)
     }
 
     /// [`Self::update_tangents`] with each law's algorithmic tangent
     /// (`LOADING = false`) or its tangent for continued loading
     /// (`LogStrainLaw::loading_tangent`, `LOADING = true`), which differ
-    /// only for points on a yield surface.
-    fn update_tangents_with<const LOADING: bool>(
+    /// only for points on a yield surface. With `norms`, also the
+    /// Frobenius norm of each full weighted tangent as the stiffness uses
+    /// it (for [`convergence::rounding_noise`]).
+    ///
+    /// Each point's $9\times 9$ tangent is read where the law leaves it
+    /// and only the `D`-dimensional components the later stages use are
+    /// kept ([`gather::PointTangent`]).
+    pub(super) fn update_tangents_with<const LOADING: bool>(
         &mut self,
         points: &PointsOf<D, P>,
+        norms: bool,
     ) -> Result<(), StepFailure> {
-        let law = &self.law;
+        let coupled = <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS;
+        let (law, alpha) = (&self.law, &self.patches.alpha);
         let it = &mut self.it;
-        it.tangent_w.resize(it.responses.len(), Tensor4::zeros());
+        let n = it.responses.len();
+        let responses = &it.responses;
+        it.tangent_w.resize(n, [[[[0.0; D]; D]; D]; D]);
+        it.tangent_norms.resize(n, 0.0);
         it.tangent_w
             .par_iter_mut()
-            .zip(it.responses.par_iter())
+            .zip(it.tangent_norms.par_iter_mut())
             .enumerate()
-            .try_for_each(|(p, (t, r))| {
-                if let Some(r) = r {
-                    let volume = P::Formulation::volume(r, points.volume[p]);
-                    // Read in place and scaled into `t`: moving the tensor
-                    // out of its `Result` and multiplying by value are two
-                    // 648-byte copies the compiler does not elide.
-                    let tangent = if LOADING {
-                        <P::Formulation as Formulation>::Tangent::loading_tangent(law, r)
+            .try_for_each(|(p, (t, norm))| {
+                let Some(r) = &responses[p] else {
+                    return Ok::<(), StepFailure>(());
+                };
+                let volume = P::Formulation::volume(r, points.volume[p]);
+                // Read in place: moving the tensor out of its `Result` is a
+                // 648-byte copy the compiler does not elide.
+                let tangent = if LOADING {
+                    <P::Formulation as Formulation>::Tangent::loading_tangent(law, r)
+                } else {
+                    <P::Formulation as Formulation>::Tangent::tangent(law, r)
+                };
+                let a = tangent
+                    .as_ref()
+                    .map_err(|source| StepFailure::Constitutive {
+                        point: p,
+                        source: *source,
+                    })?;
+                gather::restrict_tangent(a, volume, t);
+                if norms {
+                    // Of the tensor the stiffness uses: scaled by α_p under
+                    // a coupled treatment (`patch_tangents`).
+                    *norm = if coupled {
+                        (a * volume * alpha[p]).norm()
                     } else {
-                        <P::Formulation as Formulation>::Tangent::tangent(law, r)
+                        (a * volume).norm()
                     };
-                    match &tangent {
-                        Ok(a) => t.zip_apply(a, |x, y| *x = y * volume),
-                        Err(source) => {
-                            return Err(StepFailure::Constitutive {
-                                point: p,
-                                source: *source,
-                            });
-                        }
-                    }
                 }
                 Ok(())
             })?;
-        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+        if coupled {
             self.patch_tangents();
         }
         Ok(())
@@ -417,7 +436,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let f0 = self.it.f_int.clone();
         // The points that yielded in the last step sit on the yield
         // surface; the increment continues their loading.
-        self.update_tangents_with::<true>(points)?;
+        self.update_tangents_with::<true>(points, false)?;
         self.assemble_stiffness();
         let eps = LINEARISED_START_STEP;
         for (u, p) in self.it.du.iter_mut().zip(&prescribed) {
@@ -470,7 +489,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                         let mut acc = 0.0;
                         for a in 0..D {
                             for c in 0..D {
-                                acc += t[(idx(i, j), idx(a, c))] * k[(a, c)];
+                                acc += t[i][j][a][c] * k[(a, c)];
                             }
                         }
                         *bij = acc / D as f64;
@@ -480,7 +499,11 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                     let g = &grads[p * stride + slot];
                     *hv = SVector::<f64, D>::from_fn(|i, _| (0..D).map(|j| b[i][j] * g[j]).sum());
                 }
-                *t *= alpha[p];
+                t.iter_mut()
+                    .flatten()
+                    .flatten()
+                    .flatten()
+                    .for_each(|x| *x *= alpha[p]);
             });
     }
 

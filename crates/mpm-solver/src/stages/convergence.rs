@@ -1,7 +1,6 @@
 //! The out-of-balance force, the reactions and the Newton convergence test
 //! (Coombs et al. 2020 eq. 40).
 
-use mpm_constitutive::tensor::Tensor4;
 use nalgebra::SVector;
 
 use crate::error::StepFailure;
@@ -96,8 +95,9 @@ pub fn node_reactions<const D: usize>(
 }
 
 /// A bound on the rounding noise of the out-of-balance force over the free
-/// dofs, from the weighted tangents `tangent_w` ($T_p$, volume included)
-/// and the force gradients `grads`. The law evaluates each point's stress
+/// dofs, from the Frobenius norms `tangent_norms` of the weighted $9\times
+/// 9$ tangents ($\|T_p\|_F$, volume included) and the force gradients
+/// `grads`. The law evaluates each point's stress
 /// from a strain whose components carry an absolute rounding error of the
 /// order of the unit round-off $u$ (logarithms and eigenvalues of tensors
 /// near the identity), so the stress carries $\|\delta\tau_p\|\lesssim
@@ -110,11 +110,10 @@ pub fn node_reactions<const D: usize>(
 pub fn rounding_noise<const D: usize>(
     sys: &StepSystem<D>,
     grads: &[SVector<f64, D>],
-    tangent_w: &[Tensor4],
+    tangent_norms: &[f64],
 ) -> f64 {
     let mut bound = vec![0.0; sys.n_active()];
-    for (p, t) in tangent_w.iter().enumerate() {
-        let norm = t.norm();
+    for (p, &norm) in tangent_norms.iter().enumerate() {
         for s in sys.slots(p) {
             bound[sys.nodes[s] as usize] += norm * grads[s].norm();
         }

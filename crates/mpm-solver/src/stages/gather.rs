@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use crate::points::MaterialPoints;
 use crate::stages::patch::PatchSystem;
-use crate::stages::system::{NONE, NOT_A_NEIGHBOUR, PARTIAL, StepSystem};
+use crate::stages::system::{NO_ENTRY, NONE, PARTIAL, StepSystem};
 
 /// Lumped nodal mass $m_v = \sum_p S_{vp} m_p$ per active node (MPoint
 /// eq. 22; the explicit solver's), into `out` (resized).
@@ -90,6 +90,31 @@ pub fn internal_force<const D: usize>(
     });
 }
 
+/// A point's volume-weighted tangent on the components a `D`-dimensional
+/// problem reads, `t[i][j][k][l]` $= T_{ijkl}$ for $i, j, k, l < D$: the
+/// stiffness (eqs. 4/21, 27) contracts $T$ with basis gradients, whose
+/// out-of-plane component is zero, so plane strain reads 16 of the 81
+/// components of the $9\times 9$ tangent (3D reads all of them, in this
+/// order). Storing all 81 costs the specialised kernel of
+/// `benches/specialised.rs` 7–17 % of its pass over the points in 2D
+/// (`docs/src/benchmarks/zero_cost.md`).
+pub type PointTangent<const D: usize> = [[[[f64; D]; D]; D]; D];
+
+/// Writes the `D`-dimensional components of the tangent `a`
+/// ([`mpm_constitutive::tensor::idx`] storage) times `scale` into `t`.
+#[inline(always)]
+pub fn restrict_tangent<const D: usize>(a: &Tensor4, scale: f64, t: &mut PointTangent<D>) {
+    for (i, ti) in t.iter_mut().enumerate() {
+        for (j, tij) in ti.iter_mut().enumerate() {
+            for (k, tijk) in tij.iter_mut().enumerate() {
+                for (l, tijkl) in tijk.iter_mut().enumerate() {
+                    *tijkl = a[(idx(i, j), idx(k, l))] * scale;
+                }
+            }
+        }
+    }
+}
+
 /// The stiffness (eqs. 4/21, 27) in the step's CSC pattern over free
 /// dofs, $K_{(vi)(wk)} = \sum_p \nabla_j S_{vp}\,T_{ijkl}\,\nabla_l S_{wp}$
 /// with each point's volume-weighted tangent `tangent_w`; one block column
@@ -99,10 +124,14 @@ pub fn internal_force<const D: usize>(
 pub fn stiffness<const D: usize>(
     sys: &StepSystem<D>,
     grads: &[SVector<f64, D>],
-    tangent_w: &[Tensor4],
+    tangent_w: &[PointTangent<D>],
     values: &mut [f64],
 ) {
     let block = |w: usize, vals: &mut [f64]| {
+        if vals.is_empty() {
+            // Every dof of w is prescribed: no column to assemble.
+            return;
+        }
         vals.iter_mut().for_each(|x| *x = 0.0);
         let nbs = &sys.nb[sys.nb_ptr[w]..sys.nb_ptr[w + 1]];
         let map = &sys.block_map[sys.nb_ptr[w] * D * D..sys.nb_ptr[w + 1] * D * D];
@@ -119,7 +148,7 @@ pub fn stiffness<const D: usize>(
                     for k in 0..D {
                         let mut acc = 0.0;
                         for l in 0..D {
-                            acc += t[(idx(i, j), idx(k, l))] * gw[l];
+                            acc += t[i][j][k][l] * gw[l];
                         }
                         q[i][j][k] = acc;
                     }
@@ -142,10 +171,10 @@ pub fn stiffness<const D: usize>(
                             scatter_wide(&map[pos * D * D..(pos + 1) * D * D], gv, &q, vals);
                             continue;
                         }
-                        Err(_) => NOT_A_NEIGHBOUR,
+                        Err(_) => NO_ENTRY,
                     },
                 };
-                if entry == NOT_A_NEIGHBOUR {
+                if entry == NO_ENTRY {
                     continue;
                 }
                 let pos = (entry & !PARTIAL) as usize;
@@ -323,8 +352,13 @@ mod tests {
             (7, 1) | (9, _) => Some(0.0),
             _ => None,
         });
-        let tangent: Vec<Tensor4> = (0..2)
-            .map(|p| Tensor4::from_fn(|r, c| 1.0 + (r * 9 + c + 17 * p) as f64 * 0.01))
+        let tangent: Vec<PointTangent<2>> = (0..2)
+            .map(|p| {
+                let mut t = [[[[0.0; 2]; 2]; 2]; 2];
+                let a = Tensor4::from_fn(|r, c| 1.0 + (r * 9 + c + 17 * p) as f64 * 0.01);
+                restrict_tangent(&a, 1.0, &mut t);
+                t
+            })
             .collect();
         let mut with_table = vec![0.0; sys.row_idx.len()];
         sys.build_slot_offsets();
@@ -336,6 +370,26 @@ mod tests {
         stiffness(&sys, &sys.grads, &tangent, &mut searched);
         assert_eq!(with_table, searched);
         assert!(with_table.iter().all(|v| v.is_finite() && *v != 0.0));
+    }
+
+    /// The restriction keeps component (ij)(kl) of the 9 × 9 storage for
+    /// i, j, k, l < D, scaled; in 3D that is every component.
+    #[test]
+    fn the_restricted_tangent_keeps_the_in_plane_components() {
+        let a = Tensor4::from_fn(|r, c| (r * 9 + c) as f64);
+        let mut t2 = [[[[0.0; 2]; 2]; 2]; 2];
+        restrict_tangent(&a, 0.5, &mut t2);
+        assert_eq!(t2[0][1][1][0], 0.5 * (1.0 * 9.0 + 3.0));
+        assert_eq!(t2[1][1][0][1], 0.5 * (4.0 * 9.0 + 1.0));
+        let mut t3 = [[[[0.0; 3]; 3]; 3]; 3];
+        restrict_tangent(&a, 2.0, &mut t3);
+        let flat: Vec<f64> = t3.iter().flatten().flatten().flatten().copied().collect();
+        let mut all: Vec<f64> = a.iter().map(|x| 2.0 * x).collect();
+        all.sort_by(f64::total_cmp);
+        let mut sorted = flat.clone();
+        sorted.sort_by(f64::total_cmp);
+        assert_eq!(sorted, all);
+        assert_eq!(t3[2][0][1][2], 2.0 * (6.0 * 9.0 + 5.0));
     }
 
     #[test]

@@ -62,7 +62,8 @@ pub struct StepSystem<const D: usize> {
     /// (block column) in the stiffness values, so that the scatter does not
     /// search the neighbour lists in every iteration: the position `pos` of
     /// `v_a` in the neighbour list of `w_b`, plus [`PARTIAL`] when either
-    /// node has a prescribed dof. For two free nodes, row `(v_a, i)` of
+    /// node has a prescribed dof, or [`NO_ENTRY`] when either has all its
+    /// dofs prescribed. For two free nodes, row `(v_a, i)` of
     /// column `(w_b, k)` is at the block map's entry `(pos, 0, 0)` plus `i`
     /// rows and `k` column lengths; otherwise the block map places each
     /// entry. One byte per pair keeps the table small (64 bytes per point
@@ -85,9 +86,11 @@ pub const MAX_SLOT_ENTRIES: usize = 16 << 20;
 /// prescribed dof (placed entry by entry through the block map).
 pub const PARTIAL: u8 = 1 << 7;
 
-/// A [`StepSystem::slot_offset`] entry for a node not in the list (never
-/// written for a consistent system).
-pub const NOT_A_NEIGHBOUR: u8 = u8::MAX;
+/// A [`StepSystem::slot_offset`] entry with nothing to place: a node pair
+/// of which one node has every dof prescribed (its rows or its columns are
+/// not in the stiffness), or a node not in the list (never for a
+/// consistent system).
+pub const NO_ENTRY: u8 = u8::MAX;
 
 impl<const D: usize> StepSystem<D> {
     /// Number of active nodes.
@@ -223,6 +226,15 @@ impl<const D: usize> StepSystem<D> {
             .all(|&f| f != NONE)
     }
 
+    /// Whether every dof of active node `v` is prescribed (after
+    /// [`Self::build_pattern`]).
+    #[inline]
+    pub fn all_prescribed(&self, v: usize) -> bool {
+        self.free_of_dof[D * v..D * v + D]
+            .iter()
+            .all(|&f| f == NONE)
+    }
+
     /// The placement table [`Self::slot_offset`], once per step after
     /// [`Self::build_pattern`].
     pub fn build_slot_offsets(&mut self) {
@@ -230,12 +242,12 @@ impl<const D: usize> StepSystem<D> {
         self.slot_offset_ptr.clear();
         let total: usize = self.counts.iter().map(|&m| (m as usize).pow(2)).sum();
         // List positions must fit below the flag, and a flagged position
-        // must differ from `NOT_A_NEIGHBOUR`.
+        // must differ from `NO_ENTRY`.
         let widest = (0..self.n_active())
             .map(|w| self.nb_ptr[w + 1] - self.nb_ptr[w])
             .max()
             .unwrap_or(0);
-        if total > MAX_SLOT_ENTRIES || widest >= (NOT_A_NEIGHBOUR & !PARTIAL) as usize {
+        if total > MAX_SLOT_ENTRIES || widest >= (NO_ENTRY & !PARTIAL) as usize {
             return;
         }
         self.slot_offset.reserve(total);
@@ -245,14 +257,16 @@ impl<const D: usize> StepSystem<D> {
                 let w = self.nodes[b] as usize;
                 let nbs = &self.nb[self.nb_ptr[w]..self.nb_ptr[w + 1]];
                 let w_free = self.all_free(w);
+                let w_fixed = self.all_prescribed(w);
                 for a in self.slots(p) {
                     let v = self.nodes[a];
                     // Every node of the point's stencil shares the point
                     // with `w`, so it is in `w`'s neighbour list.
                     let entry = match nbs.binary_search(&v) {
+                        _ if w_fixed || self.all_prescribed(v as usize) => NO_ENTRY,
                         Ok(pos) if w_free && self.all_free(v as usize) => pos as u8,
                         Ok(pos) => PARTIAL | pos as u8,
-                        Err(_) => NOT_A_NEIGHBOUR,
+                        Err(_) => NO_ENTRY,
                     };
                     self.slot_offset.push(entry);
                 }
