@@ -177,12 +177,10 @@ pub fn stiffness<const D: usize>(
                 if entry == NO_ENTRY {
                     continue;
                 }
-                let pos = (entry & !PARTIAL) as usize;
-                let rows = &map[pos * D * D..(pos + 1) * D * D];
                 if entry & PARTIAL == 0 {
                     // Both nodes free: rows i and columns k are contiguous
-                    // from the pair's first entry.
-                    let base = rows[0] as usize;
+                    // from the pair's first entry, which the table holds.
+                    let base = entry as usize;
                     for k in 0..D {
                         for i in 0..D {
                             let mut acc = 0.0;
@@ -194,7 +192,8 @@ pub fn stiffness<const D: usize>(
                     }
                     continue;
                 }
-                scatter_wide(rows, gv, &q, vals);
+                let pos = (entry & !PARTIAL) as usize;
+                scatter_wide(&map[pos * D * D..(pos + 1) * D * D], gv, &q, vals);
             }
         }
     };
@@ -337,6 +336,34 @@ mod tests {
         sys
     }
 
+    /// Two points' tangents.
+    fn tangents() -> Vec<PointTangent<2>> {
+        (0..2)
+            .map(|p| {
+                let mut t = [[[[0.0; 2]; 2]; 2]; 2];
+                let a = Tensor4::from_fn(|r, c| 1.0 + (r * 9 + c + 17 * p) as f64 * 0.01);
+                restrict_tangent(&a, 1.0, &mut t);
+                t
+            })
+            .collect()
+    }
+
+    /// The stiffness placed through the table [`StepSystem::slot_offset`]
+    /// and by the search it replaces, bit for bit; returns it.
+    fn table_equals_search(sys: &mut StepSystem<2>) -> Vec<f64> {
+        let tangent = tangents();
+        let mut with_table = vec![0.0; sys.row_idx.len()];
+        sys.build_slot_offsets();
+        assert!(!sys.slot_offset.is_empty());
+        stiffness(sys, &sys.grads, &tangent, &mut with_table);
+        sys.slot_offset.clear();
+        sys.slot_offset_ptr.clear();
+        let mut searched = vec![f64::NAN; sys.row_idx.len()];
+        stiffness(sys, &sys.grads, &tangent, &mut searched);
+        assert_eq!(with_table, searched);
+        with_table
+    }
+
     /// The placement table and the search it replaces give the same
     /// stiffness, bit for bit, with free, partly prescribed and fixed
     /// nodes.
@@ -352,24 +379,55 @@ mod tests {
             (7, 1) | (9, _) => Some(0.0),
             _ => None,
         });
-        let tangent: Vec<PointTangent<2>> = (0..2)
-            .map(|p| {
-                let mut t = [[[[0.0; 2]; 2]; 2]; 2];
-                let a = Tensor4::from_fn(|r, c| 1.0 + (r * 9 + c + 17 * p) as f64 * 0.01);
-                restrict_tangent(&a, 1.0, &mut t);
-                t
-            })
-            .collect();
-        let mut with_table = vec![0.0; sys.row_idx.len()];
+        let k = table_equals_search(&mut sys);
+        assert!(k.iter().all(|v| v.is_finite() && *v != 0.0));
+    }
+
+    /// Block columns longer than the table's direct offsets (a point with
+    /// 70 nodes: columns of 140 rows) place the far pairs through the
+    /// block map, and still as the search does.
+    #[test]
+    fn long_columns_fall_back_to_the_block_map() {
+        let stride = 70;
+        let mut nodes: Vec<u32> = (0..70).collect();
+        nodes.extend([66, 68, 70]);
+        nodes.resize(2 * stride, 0);
+        let mut sys = StepSystem::<2> {
+            stride,
+            values: vec![0.5; 2 * stride],
+            grads: (0..2 * stride)
+                .map(|s| SVector::<f64, 2>::new((0.7 * s as f64).sin(), (1.3 * s as f64).cos()))
+                .collect(),
+            nodes,
+            counts: vec![70, 3],
+            ..StepSystem::default()
+        };
+        sys.number_nodes(71);
+        sys.build_adjacency();
+        sys.build_neighbours();
+        // Mesh node 0 fixed, every other node free: a flagged entry can
+        // only be a fall-back.
+        sys.build_pattern(|node, _| (node == 0).then_some(0.0));
+        let k = table_equals_search(&mut sys);
+        assert!(k.iter().all(|v| v.is_finite()));
+        // Both kinds of free pairs occur: direct offsets and the flagged
+        // fall-back.
         sys.build_slot_offsets();
-        assert!(!sys.slot_offset.is_empty());
-        stiffness(&sys, &sys.grads, &tangent, &mut with_table);
-        sys.slot_offset.clear();
-        sys.slot_offset_ptr.clear();
-        let mut searched = vec![f64::NAN; sys.row_idx.len()];
-        stiffness(&sys, &sys.grads, &tangent, &mut searched);
-        assert_eq!(with_table, searched);
-        assert!(with_table.iter().all(|v| v.is_finite() && *v != 0.0));
+        let free_pair = |e: u8| e != NO_ENTRY;
+        let direct = sys
+            .slot_offset
+            .iter()
+            .filter(|&&e| e & PARTIAL == 0)
+            .count();
+        let flagged = sys
+            .slot_offset
+            .iter()
+            .filter(|&&e| free_pair(e) && e & PARTIAL != 0)
+            .count();
+        assert!(
+            direct > 0 && flagged > 0,
+            "{direct} direct, {flagged} flagged"
+        );
     }
 
     /// The restriction keeps component (ij)(kl) of the 9 × 9 storage for

@@ -60,13 +60,13 @@ pub struct StepSystem<const D: usize> {
     /// `slot_offset[slot_offset_ptr[p] + b * m + a]` that place the
     /// coupling of the node of slot `a` (row) with the node of slot `b`
     /// (block column) in the stiffness values, so that the scatter does not
-    /// search the neighbour lists in every iteration: the position `pos` of
-    /// `v_a` in the neighbour list of `w_b`, plus [`PARTIAL`] when either
-    /// node has a prescribed dof, or [`NO_ENTRY`] when either has all its
-    /// dofs prescribed. For two free nodes, row `(v_a, i)` of
-    /// column `(w_b, k)` is at the block map's entry `(pos, 0, 0)` plus `i`
-    /// rows and `k` column lengths; otherwise the block map places each
-    /// entry. One byte per pair keeps the table small (64 bytes per point
+    /// search the neighbour lists in every iteration. For two free nodes,
+    /// the offset `first` of row `(v_a, 0)` of column `(w_b, 0)` in the
+    /// block's values when it is below [`PARTIAL`]: row `(v_a, i)` of
+    /// column `(w_b, k)` is then at `first` plus `i` rows and `k` column
+    /// lengths. Otherwise the position `pos` of `v_a` in the neighbour list
+    /// of `w_b` plus [`PARTIAL`], and the block map places each entry; or
+    /// [`NO_ENTRY`] when either node has all its dofs prescribed. One byte per pair keeps the table small (64 bytes per point
     /// for linear hexahedra), which matters more than the indirection: the
     /// stiffness pass reads every point once from each of its nodes, a grid
     /// layer apart. Empty when a neighbour list has more than 126 entries
@@ -82,8 +82,9 @@ pub struct StepSystem<const D: usize> {
 /// beyond it the stiffness scatter searches the neighbour lists.
 pub const MAX_SLOT_ENTRIES: usize = 16 << 20;
 
-/// Flag of a [`StepSystem::slot_offset`] entry for a node pair with a
-/// prescribed dof (placed entry by entry through the block map).
+/// Flag of a [`StepSystem::slot_offset`] entry placed entry by entry
+/// through the block map: a node pair with a prescribed dof, or one whose
+/// first offset does not fit below the flag.
 pub const PARTIAL: u8 = 1 << 7;
 
 /// A [`StepSystem::slot_offset`] entry with nothing to place: a node pair
@@ -264,7 +265,15 @@ impl<const D: usize> StepSystem<D> {
                     // with `w`, so it is in `w`'s neighbour list.
                     let entry = match nbs.binary_search(&v) {
                         _ if w_fixed || self.all_prescribed(v as usize) => NO_ENTRY,
-                        Ok(pos) if w_free && self.all_free(v as usize) => pos as u8,
+                        Ok(pos) if w_free && self.all_free(v as usize) => {
+                            // The offset of row (v, 0) in column (w, 0)
+                            // when it fits below the flag.
+                            let first = self.block_map[(self.nb_ptr[w] + pos) * D * D];
+                            match u8::try_from(first) {
+                                Ok(first) if first < PARTIAL => first,
+                                _ => PARTIAL | pos as u8,
+                            }
+                        }
                         Ok(pos) => PARTIAL | pos as u8,
                         Err(_) => NO_ENTRY,
                     };
