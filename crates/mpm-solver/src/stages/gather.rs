@@ -413,7 +413,6 @@ mod tests {
         // Both kinds of free pairs occur: direct offsets and the flagged
         // fall-back.
         sys.build_slot_offsets();
-        let free_pair = |e: u8| e != NO_ENTRY;
         let direct = sys
             .slot_offset
             .iter()
@@ -422,7 +421,7 @@ mod tests {
         let flagged = sys
             .slot_offset
             .iter()
-            .filter(|&&e| free_pair(e) && e & PARTIAL != 0)
+            .filter(|&&e| e != NO_ENTRY && e & PARTIAL != 0)
             .count();
         assert!(
             direct > 0 && flagged > 0,

@@ -261,10 +261,13 @@ impl<const D: usize> StepSystem<D> {
                 let w_fixed = self.all_prescribed(w);
                 for a in self.slots(p) {
                     let v = self.nodes[a];
+                    if w_fixed || self.all_prescribed(v as usize) {
+                        self.slot_offset.push(NO_ENTRY);
+                        continue;
+                    }
                     // Every node of the point's stencil shares the point
                     // with `w`, so it is in `w`'s neighbour list.
                     let entry = match nbs.binary_search(&v) {
-                        _ if w_fixed || self.all_prescribed(v as usize) => NO_ENTRY,
                         Ok(pos) if w_free && self.all_free(v as usize) => {
                             // The offset of row (v, 0) in column (w, 0)
                             // when it fits below the flag.
