@@ -6,7 +6,11 @@
 //! locking, no domain update — timed two ways on the same points and
 //! increment, in 2D and 3D, on 1 and 2 threads:
 //!
-//! - **generic**: [`ImplicitSolver::assemble_at`], the framework's path;
+//! - **generic**: [`ImplicitSolver::assemble_at`], the framework's path
+//!   on an iteration Newton expects to correct (the update computes the
+//!   tangents in the same pass); `generic_in_stages` is
+//!   [`ImplicitSolver::assemble_in_stages_at`], the stages one by one as
+//!   on an iteration that was expected to converge but did not;
 //! - **specialised**: [`Specialised::assemble`], a kernel written for
 //!   exactly that scene (one fused pass per point with no `Option`
 //!   responses, no locking hook, no formulation dispatch; one fused pass
@@ -19,7 +23,9 @@
 //!
 //! The `stages_*` groups (one thread) say where the difference comes from:
 //! the generic solver's public stages (`update_material_points`,
-//! `assemble_internal_force`, `update_tangents`, `assemble_stiffness`)
+//! `assemble_internal_force`, `update_tangents`, `assemble_stiffness`,
+//! and `update_material_points_with_tangents`, which fuses the first and
+//! third)
 //! against the kernel's two passes, and between them variants of the
 //! kernel that add back one thing the generic path does or did: the
 //! excessive-increment test (`checked_points_pass`), responses stored
@@ -778,6 +784,15 @@ fn check<const D: usize>(
             let ratio = s.solver.assemble_at(&s.points, &s.du).unwrap();
             (ratio, s.solver.free_stiffness().unwrap().values.to_vec())
         });
+        // The iteration through the separate stages computes the same.
+        let in_stages = pool.install(|| {
+            let ratio = s.solver.assemble_in_stages_at(&s.points, &s.du).unwrap();
+            (ratio, s.solver.free_stiffness().unwrap().values.to_vec())
+        });
+        assert!(
+            in_stages == generic,
+            "{name}: the stages differ from the fused pass"
+        );
         let special = pool.install(|| {
             let ratio = k.assemble(&s.points, &s.du).unwrap();
             (ratio, k.values.clone(), k.f_int.clone())
@@ -865,6 +880,9 @@ fn compare<const D: usize>(c: &mut Criterion, name: &str, cells: [usize; D]) {
         group.bench_function(BenchmarkId::new("generic", threads), |b| {
             pool.install(|| b.iter(|| black_box(solver.assemble_at(points, du).unwrap())))
         });
+        group.bench_function(BenchmarkId::new("generic_in_stages", threads), |b| {
+            pool.install(|| b.iter(|| black_box(solver.assemble_in_stages_at(points, du).unwrap())))
+        });
         group.bench_function(BenchmarkId::new("specialised", threads), |b| {
             pool.install(|| b.iter(|| black_box(k.assemble(points, du).unwrap())))
         });
@@ -898,6 +916,13 @@ fn stages<const D: usize>(c: &mut Criterion, name: &str, cells: [usize; D]) {
     });
     group.bench_function("generic_assemble_stiffness", |b| {
         pool.install(|| b.iter(|| solver.assemble_stiffness()))
+    });
+    // Last of the generic stages: it leaves no responses behind.
+    group.bench_function("generic_update_material_points_with_tangents", |b| {
+        pool.install(|| b.iter(|| solver.update_material_points_with_tangents(points).unwrap()))
+    });
+    group.bench_function("generic_assemble_internal_force_and_stiffness", |b| {
+        pool.install(|| b.iter(|| solver.assemble_internal_force_and_stiffness()))
     });
     let mut responses = vec![None; points.len()];
     let mut tangents = vec![Tensor4::zeros(); points.len()];

@@ -185,6 +185,15 @@ pub enum SolverError {
     /// The locking treatment could not place the points in patches.
     #[error("locking treatment: {0}")]
     Locking(#[from] LockingError),
+    /// The converged state of a step could not be recomputed for the
+    /// commit (the update that passed during the iterations failed when
+    /// repeated at the same increment).
+    #[error("recomputing the converged state for the commit: {cause}")]
+    Commit {
+        /// What failed.
+        #[source]
+        cause: StepFailure,
+    },
     /// An error that stopped a load step without a retry (a point outside
     /// the mesh, a domain that cannot be updated, a mesh that cannot
     /// move, ...), with the step it stopped: the outputs of the steps

@@ -75,6 +75,23 @@ where
         exported[c * n + r] += *v;
     }
     assert_eq!(exported, k);
+    // The fused pass that gave `k` and the separate stages agree bit for
+    // bit: residual, stiffness, and the state each commits (the fused
+    // pass keeps no responses, so its commit recomputes them).
+    let residual = solver.normalised_residual();
+    let mut fused = points.clone();
+    solver.commit(&mut fused).unwrap();
+    let in_stages = solver.assemble_in_stages_at(&points, &du).unwrap();
+    assert_eq!(in_stages.to_bits(), residual.to_bits());
+    let mut k_stages = vec![0.0; n * n];
+    for (v, (r, c)) in solver.free_stiffness().unwrap().to_sprs().unwrap().iter() {
+        k_stages[c * n + r] += *v;
+    }
+    assert_eq!(k_stages, k);
+    let mut staged = points.clone();
+    solver.commit(&mut staged).unwrap();
+    assert_eq!(format!("{fused:?}"), format!("{staged:?}"));
+    assert_ne!(format!("{staged:?}"), format!("{points:?}"));
     common::worst_column_error(&mut solver, &points, &du, &k)
 }
 

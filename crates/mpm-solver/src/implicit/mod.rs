@@ -15,8 +15,14 @@
 //!    (eq. 7, the constitutive update), [`assemble_internal_force`](ImplicitSolver::assemble_internal_force)
 //!    (eqs. 6/23, 28), the convergence test on eq. (40)
 //!    ([`NewtonMonitor`]), then
-//!    [`assemble_stiffness`](ImplicitSolver::assemble_stiffness) (eqs. 4/21, 27)
-//!    and the linear solve (eqs. 26, 30);
+//!    [`update_tangents`](ImplicitSolver::update_tangents) (eqs. A.1,
+//!    A.3–A.6), [`assemble_stiffness`](ImplicitSolver::assemble_stiffness)
+//!    (eqs. 4/21, 27) and the linear solve (eqs. 26, 30). On an iterate
+//!    that Newton expects to correct
+//!    ([`NewtonMonitor::expects_correction`]) the update computes the
+//!    tangents in the same pass instead
+//!    ([`update_material_points_with_tangents`](ImplicitSolver::update_material_points_with_tangents)),
+//!    bit for bit the same numbers without storing the responses;
 //! 5. [`commit`](ImplicitSolver::commit): positions (eq. 31), deformation,
 //!    volumes, history and domains.
 //!
@@ -53,6 +59,7 @@ use std::time::Instant;
 fn lap(clock: Instant) -> f64 {
     clock.elapsed().as_secs_f64()
 }
+use crate::locking::LockingTreatment;
 use crate::parts::{PointsOf, SolverParts};
 use crate::stages::convergence::{self, NewtonMonitor, Verdict};
 use crate::stages::gather::PointTangent;
@@ -69,6 +76,9 @@ struct Iterate<const D: usize, H> {
     rhs: Vec<f64>,
     values: Vec<f64>,
     responses: Vec<Option<Response<H>>>,
+    /// `responses` belong to the current increment `du` (false after the
+    /// fused update-with-tangents pass and after a failed update).
+    responses_current: bool,
     stress_w: Vec<Matrix3<f64>>,
     /// Per point, the weighted tangent's components in use.
     tangent_w: Vec<PointTangent<D>>,
@@ -90,6 +100,7 @@ impl<const D: usize, H> Default for Iterate<D, H> {
             rhs: Vec::new(),
             values: Vec::new(),
             responses: Vec::new(),
+            responses_current: false,
             stress_w: Vec::new(),
             tangent_w: Vec::new(),
             tangent_norms: Vec::new(),
@@ -134,6 +145,9 @@ pub struct ImplicitSolver<const D: usize, P: SolverParts<D>> {
     it: Iterate<D, P::History>,
     /// The last converged increment per mesh dof and its load increment.
     previous: Option<(Vec<f64>, f64)>,
+    /// The last converged step converged on its first iterate
+    /// ([`NewtonMonitor::expecting_first_correction`]).
+    first_iterate_converged: bool,
     /// Per point, the cell where its location starts (the parent cell of
     /// the last step; walking on unstructured meshes, Wang et al. 2021
     /// Algorithm 1); `usize::MAX` when unknown.
@@ -170,6 +184,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             ghost: GhostFaces::default(),
             it: Iterate::default(),
             previous: None,
+            first_iterate_converged: false,
             hints: Vec::new(),
         }
     }
@@ -224,39 +239,60 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         }
         let o = &self.options;
         let mut monitor = NewtonMonitor::new(o.tolerance, o.divergence_factor, o.max_iterations)
-            .with_rounding_floor(o.rounding_floor_factor);
+            .with_rounding_floor(o.rounding_floor_factor)
+            .expecting_first_correction(!self.first_iterate_converged);
         let mut backtracked = Vec::new();
         let mut initial_unbalance = None;
         let retry = |cause, monitor: &NewtonMonitor| StepError::Retry {
             cause,
             last_residual: monitor.last(),
         };
-        loop {
+        let mut fused_updates = 0;
+        // Whether the converged iterate's fused tangents went unused.
+        let unused_tangents = loop {
             let iteration = monitor.iteration();
+            // The first iteration's tangents also give the rounding noise.
+            let first = iteration == 0;
+            // Where Newton expects to correct this iterate, its tangents
+            // come with the update (a coupled treatment gains nothing: it
+            // keeps the responses for its patch terms).
+            let fused = !<P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS
+                && monitor.expects_correction();
+            fused_updates += usize::from(fused);
             let clock = Instant::now();
-            match self.update_material_points_backtracking(points, iteration > 0) {
+            match self.update_material_points_backtracking(
+                points,
+                iteration > 0,
+                fused.then_some(first),
+            ) {
                 Ok(true) => backtracked.push(iteration),
                 Ok(false) => {}
                 Err(cause) => return Err(retry(cause, &monitor)),
             }
             times.material += lap(clock);
             let clock = Instant::now();
-            self.assemble_internal_force();
-            times.force += lap(clock);
+            if fused {
+                // The stiffness is known before the test as well.
+                self.assemble_internal_force_and_stiffness();
+                times.stiffness += lap(clock);
+            } else {
+                self.assemble_internal_force();
+                times.force += lap(clock);
+            }
             if iteration == 0 {
                 initial_unbalance = convergence::unbalance_all_dofs(&self.it.f_int, &self.it.f_ext);
             }
             let (r, d) = convergence::residual_parts(&self.system, &self.it.f_int, &self.it.f_ext);
             match monitor.check(r, d) {
-                Verdict::Converged => break,
+                Verdict::Converged => break fused,
                 Verdict::Failed(cause) => return Err(retry(cause, &monitor)),
                 Verdict::Continue => {}
             }
             let clock = Instant::now();
-            // The first iteration's tangents also give the rounding noise.
-            let first = iteration == 0;
-            self.update_tangents_with::<false>(points, first)
-                .map_err(|cause| retry(cause, &monitor))?;
+            if !fused {
+                self.update_tangents_with::<false>(points, first)
+                    .map_err(|cause| retry(cause, &monitor))?;
+            }
             if first {
                 monitor.set_rounding_noise(convergence::rounding_noise(
                     &self.system,
@@ -265,15 +301,18 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 ));
             }
             times.tangent += lap(clock);
-            let clock = Instant::now();
-            self.assemble_stiffness();
-            times.stiffness += lap(clock);
+            if !fused {
+                let clock = Instant::now();
+                self.assemble_stiffness();
+                times.stiffness += lap(clock);
+            }
             let clock = Instant::now();
             self.solve()
                 .map_err(|source| retry(StepFailure::LinearSolve { source }, &monitor))?;
             times.solve += lap(clock);
             linear_iterations += self.linear.last_iterations();
-        }
+        };
+        self.first_iterate_converged = monitor.iteration() == 1;
         let clock = Instant::now();
         let reaction = convergence::reaction(&self.system, &self.it.f_int, &self.it.f_ext);
         let node_reactions =
@@ -297,6 +336,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             factorisation: self.linear.last_factorisation(),
             backtracked,
             linearised_start,
+            fused_updates,
+            unused_tangents,
             times,
             linear_iterations,
             cuts: Vec::new(),
@@ -318,8 +359,10 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     }
 
     /// The stiffness last assembled on the current load step's system (in
-    /// a converged step: at the last iterate before the final correction),
-    /// or `None` if the step converged without assembling one.
+    /// a converged step: at the last iterate before the final correction,
+    /// or at the converged iterate when Newton expected to correct it,
+    /// [`StepReport::unused_tangents`]), or `None` if the step converged
+    /// without assembling one.
     pub fn free_stiffness(&self) -> Option<FreeStiffness<'_>> {
         self.it.stiffness_assembled.then(|| FreeStiffness {
             n: self.system.n_free,

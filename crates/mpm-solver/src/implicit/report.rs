@@ -52,6 +52,15 @@ pub struct StepReport<const D: usize> {
     /// converged state ([`crate::FirstTangent::Converged`]): one
     /// assembly and solve more than `residuals` counts.
     pub linearised_start: bool,
+    /// Iterations whose update computed the tangents in the same pass
+    /// because Newton expected to correct them
+    /// ([`crate::ImplicitSolver::update_material_points_with_tangents`]).
+    pub fused_updates: usize,
+    /// Whether the converged iterate was one of them: its tangents and
+    /// stiffness went unused and the commit recomputed the responses (a
+    /// wrong prediction of
+    /// [`crate::stages::convergence::NewtonMonitor::expects_correction`]).
+    pub unused_tangents: bool,
     /// Wall-clock seconds of each stage over the step (all iterations).
     pub times: StageTimes,
     /// Iterations of the iterative linear solver over the step (0 with a
@@ -89,9 +98,12 @@ pub struct StageTimes {
     /// linear solver's symbolic analysis (once per step).
     pub system: f64,
     /// $\Delta F$, the locking treatment and the constitutive update
-    /// (every iteration, with backtracking).
+    /// (every iteration, with backtracking), with the tangents on the
+    /// iterations that compute them in the same pass
+    /// ([`StepReport::fused_updates`]).
     pub material: f64,
-    /// The internal force.
+    /// The internal force (in the stiffness's pass on the iterations
+    /// that compute their tangents with the update).
     pub force: f64,
     /// The consistent tangents (and a patch treatment's coupling vectors).
     pub tangent: f64,

@@ -3,8 +3,11 @@
 //! [`crate::stages`], plus the constitutive update and tangents, which
 //! depend on the formulation.
 
-use mpm_constitutive::{ConsistentTangent, ConstitutiveError, LogStrainLaw, MaterialState, update};
+use mpm_constitutive::{
+    ConsistentTangent, ConstitutiveError, LogStrainLaw, MaterialState, Response, update,
+};
 use nalgebra::{Matrix3, SVector};
+use rayon::iter::Either;
 use rayon::prelude::*;
 
 use super::{ImplicitSolver, MAX_BACKTRACKS};
@@ -15,7 +18,8 @@ use crate::linear::LinearSolveError;
 use crate::locking::{LockingTreatment, PatchInput};
 use crate::mesh::NodalMesh;
 use crate::parts::{PointsOf, SolverParts};
-use crate::stages::system::NONE;
+use crate::stages::patch::PatchSystem;
+use crate::stages::system::{NONE, StepSystem};
 use crate::stages::{basis, gather, update as grid_to_point};
 
 /// $\epsilon$ of the forward difference in
@@ -32,6 +36,94 @@ fn failed_point(f: &StepFailure) -> Option<usize> {
             Some(*point)
         }
         _ => None,
+    }
+}
+
+/// Of two parallel partial results, the failure of the lowest point,
+/// whatever the thread count.
+fn lowest_failure(a: Option<StepFailure>, b: Option<StepFailure>) -> Option<StepFailure> {
+    match (
+        a.as_ref().and_then(failed_point),
+        b.as_ref().and_then(failed_point),
+    ) {
+        (Some(pa), Some(pb)) if pb < pa => b,
+        (Some(_), _) => a,
+        _ => b,
+    }
+}
+
+/// What the pass over points of stage 4a reads.
+struct PointPass<'a, const D: usize, P: SolverParts<D>> {
+    sys: &'a StepSystem<D>,
+    du: &'a [f64],
+    law: &'a P::Law,
+    patches: &'a PatchSystem<D>,
+    increments: &'a [Matrix3<f64>],
+    points: &'a PointsOf<D, P>,
+    limit: f64,
+}
+
+impl<const D: usize, P: SolverParts<D>> PointPass<'_, D, P> {
+    /// $\Delta F$ of point `p`, its update and the excessive-increment
+    /// test; `then` reads the response in place (moving a 672-byte
+    /// response out of its `Result` is a copy the compiler does not
+    /// elide).
+    #[inline(always)]
+    fn respond(
+        &self,
+        p: usize,
+        then: impl FnOnce(&Response<P::History>) -> Option<StepFailure>,
+    ) -> Option<StepFailure> {
+        // The motion's ΔF (eq. 7), or the patch-averaged ΔF̄ the law sees
+        // under a coupled treatment (Wang et al. eq. 9).
+        let delta_f = if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+            self.patches.modified(p, &self.increments[p])
+        } else {
+            grid_to_point::deformation_increment(self.sys, self.du, p)
+        };
+        let state = MaterialState {
+            be: self.points.be[p],
+            history: self.points.history[p],
+        };
+        let response = update(self.law, &delta_f, &self.points.f[p], &state);
+        let r = match response.as_ref() {
+            Ok(r) => r,
+            Err(source) => {
+                return Some(StepFailure::Constitutive {
+                    point: p,
+                    source: *source,
+                });
+            }
+        };
+        // Squared norms: the square root only for the report.
+        let squared = r.delta_f.norm_squared().max(r.delta_f_inv.norm_squared());
+        let limit = self.limit;
+        if squared > limit * limit {
+            return Some(StepFailure::ExcessiveIncrement {
+                point: p,
+                norm: squared.sqrt(),
+                limit,
+            });
+        }
+        then(r)
+    }
+
+    /// The weighted stress of point `p` and, for a formulation that maps
+    /// them, its mapped basis gradients (eq. 8) into `chunk`.
+    #[inline(always)]
+    fn weigh(
+        &self,
+        p: usize,
+        r: &Response<P::History>,
+        stress: &mut Matrix3<f64>,
+        chunk: &mut [SVector<f64, D>],
+    ) {
+        *stress = P::Formulation::stress(r) * P::Formulation::volume(r, self.points.volume[p]);
+        if <P::Formulation as Formulation>::MAPS_GRADIENTS {
+            for (a, s) in self.sys.slots(p).enumerate() {
+                chunk[a] = P::Formulation::map_gradient(r, &self.sys.grads[s]);
+            }
+        }
     }
 }
 
@@ -189,12 +281,20 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// step is declared failed. Sparsely populated cells give nodes with
     /// little stiffness whose corrections can overshoot; backtracking keeps
     /// Newton on track without changing the converged solution.
+    ///
+    /// With `tangents = Some(norms)`, the update is the fused pass with the
+    /// tangents ([`Self::update_with_tangents`]).
     pub(super) fn update_material_points_backtracking(
         &mut self,
         points: &PointsOf<D, P>,
         after_solve: bool,
+        tangents: Option<bool>,
     ) -> Result<bool, StepFailure> {
-        let mut result = self.update_material_points(points);
+        let update = |s: &mut Self| match tangents {
+            Some(norms) => s.update_with_tangents(points, norms),
+            None => s.update_material_points(points),
+        };
+        let mut result = update(self);
         let mut backtracks = 0;
         while let Err(StepFailure::Constitutive { .. } | StepFailure::ExcessiveIncrement { .. }) =
             result
@@ -212,23 +312,76 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                     it.rhs[free as usize] = half;
                 }
             }
-            result = self.update_material_points(points);
+            result = update(self);
         }
         result.map(|()| backtracks > 0)
     }
 
     /// Stage 4a: for every point, $\Delta F$ from the grid displacement
     /// increment (eq. 7), the locking treatment, the constitutive update
-    /// and the weighted stress of the formulation.
+    /// and the weighted stress of the formulation. Keeps every point's
+    /// response for the tangents ([`Self::update_tangents`]) and the
+    /// commit.
     pub fn update_material_points(&mut self, points: &PointsOf<D, P>) -> Result<(), StepFailure> {
+        self.material_pass::<false>(points, false)
+    }
+
+    /// Stages 4a and 4c in one pass over the points: what
+    /// [`Self::update_material_points`] and then [`Self::update_tangents`]
+    /// compute, bit for bit, without keeping the responses. Newton runs it
+    /// on the iterations it expects to correct
+    /// ([`crate::stages::convergence::NewtonMonitor::expects_correction`]):
+    /// writing a point's response costs as much memory traffic as reading
+    /// it back for the tangent, and an iteration that needs a tangent has
+    /// no other use for it. The commit recomputes the responses of the
+    /// converged increment when the last update was this one. A locking
+    /// treatment that couples points needs the responses for its patch
+    /// terms and runs the two stages.
+    pub fn update_material_points_with_tangents(
+        &mut self,
+        points: &PointsOf<D, P>,
+    ) -> Result<(), StepFailure> {
+        self.update_with_tangents(points, false)
+    }
+
+    /// [`Self::update_material_points_with_tangents`], with the norms of
+    /// [`Self::update_tangents_with`] on request.
+    pub(super) fn update_with_tangents(
+        &mut self,
+        points: &PointsOf<D, P>,
+        norms: bool,
+    ) -> Result<(), StepFailure> {
+        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+            self.material_pass::<false>(points, false)?;
+            self.update_tangents_with::<false>(points, norms)
+        } else {
+            self.material_pass::<true>(points, norms)
+        }
+    }
+
+    /// The pass over points of stage 4a, with the tangents of stage 4c
+    /// instead of the stored responses when `TANGENTS`.
+    fn material_pass<const TANGENTS: bool>(
+        &mut self,
+        points: &PointsOf<D, P>,
+        norms: bool,
+    ) -> Result<(), StepFailure> {
         let n = points.len();
         let sys = &self.system;
         let it = &mut self.it;
         let maps_gradients = <P::Formulation as Formulation>::MAPS_GRADIENTS;
-        it.responses.resize(n, None);
         it.stress_w.resize(n, Matrix3::zeros());
         if maps_gradients {
             it.mapped.resize(sys.grads.len(), SVector::zeros());
+        }
+        // Until this pass succeeds, no stored response belongs to the
+        // current increment.
+        it.responses_current = false;
+        if TANGENTS {
+            it.tangent_w.resize(n, [[[[0.0; D]; D]; D]; D]);
+            it.tangent_norms.resize(n, 0.0);
+        } else {
+            it.responses.resize(n, None);
         }
         let du = &it.du;
         let coupled = <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS;
@@ -248,73 +401,81 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                     },
                 })?;
         }
-        let (law, patches, increments) = (&self.law, &self.patches, &it.increments);
+        let (law, patches, increments) = (&self.law, &self.patches, &it.increments[..]);
         let limit = self.options.max_increment_norm;
-        let stride = sys.stride;
-        let mapped_chunks = it.mapped.par_chunks_mut(stride.max(1));
-        let failure = it
-            .responses
-            .par_iter_mut()
-            .zip(it.stress_w.par_iter_mut())
-            .enumerate()
-            .map(|(p, (response, stress))| {
-                // The motion's ΔF (eq. 7), or the patch-averaged ΔF̄ the
-                // law sees under a coupled treatment (Wang et al. eq. 9).
-                let delta_f = if coupled {
-                    patches.modified(p, &increments[p])
-                } else {
-                    grid_to_point::deformation_increment(sys, du, p)
-                };
-                let state = MaterialState {
-                    be: points.be[p],
-                    history: points.history[p],
-                };
-                match update(law, &delta_f, &points.f[p], &state) {
-                    Ok(r) => {
-                        // Squared norms: the square root only for the
-                        // report.
-                        let squared = r.delta_f.norm_squared().max(r.delta_f_inv.norm_squared());
-                        if squared > limit * limit {
-                            return Some(StepFailure::ExcessiveIncrement {
-                                point: p,
-                                norm: squared.sqrt(),
-                                limit,
-                            });
+        let stride = sys.stride.max(1);
+        // Each point's slots of the mapped gradients, or an empty slice
+        // per point when the formulation does not map them.
+        let mapped = if maps_gradients {
+            Either::Left(it.mapped.par_chunks_mut(stride))
+        } else {
+            Either::Right(
+                (0..n)
+                    .into_par_iter()
+                    .map(|_| <&mut [SVector<f64, D>]>::default()),
+            )
+        };
+        let pass = PointPass::<D, P> {
+            sys,
+            du,
+            law,
+            patches,
+            increments,
+            points,
+            limit,
+        };
+        let failure = if TANGENTS {
+            it.stress_w
+                .par_iter_mut()
+                .zip(mapped)
+                .zip(it.tangent_w.par_iter_mut())
+                .zip(it.tangent_norms.par_iter_mut())
+                .enumerate()
+                .map(|(p, (((stress, chunk), t), norm))| {
+                    pass.respond(p, |r| {
+                        pass.weigh(p, r, stress, chunk);
+                        let volume = P::Formulation::volume(r, points.volume[p]);
+                        // Read in place, as the response.
+                        let tangent = <P::Formulation as Formulation>::Tangent::tangent(law, r);
+                        let a = match tangent.as_ref() {
+                            Ok(a) => a,
+                            Err(source) => {
+                                return Some(StepFailure::Constitutive {
+                                    point: p,
+                                    source: *source,
+                                });
+                            }
+                        };
+                        gather::restrict_tangent(a, volume, t);
+                        if norms {
+                            *norm = (a * volume).norm();
                         }
-                        *stress = P::Formulation::stress(&r)
-                            * P::Formulation::volume(&r, points.volume[p]);
-                        *response = Some(r);
                         None
-                    }
-                    Err(source) => Some(StepFailure::Constitutive { point: p, source }),
-                }
-            })
-            .reduce(
-                || None,
-                // The failure of the lowest point, whatever the thread count.
-                |a, b| match (
-                    a.as_ref().and_then(failed_point),
-                    b.as_ref().and_then(failed_point),
-                ) {
-                    (Some(pa), Some(pb)) if pb < pa => b,
-                    (Some(_), _) => a,
-                    _ => b,
-                },
-            );
-        if let Some(f) = failure {
-            return Err(f);
+                    })
+                })
+                .reduce(|| None, lowest_failure)
+        } else {
+            it.stress_w
+                .par_iter_mut()
+                .zip(mapped)
+                .zip(it.responses.par_iter_mut())
+                .enumerate()
+                .map(|(p, ((stress, chunk), response))| {
+                    pass.respond(p, |r| {
+                        pass.weigh(p, r, stress, chunk);
+                        *response = Some(*r);
+                        None
+                    })
+                })
+                .reduce(|| None, lowest_failure)
+        };
+        match failure {
+            Some(f) => Err(f),
+            None => {
+                it.responses_current = !TANGENTS;
+                Ok(())
+            }
         }
-        if maps_gradients {
-            let responses = &it.responses;
-            mapped_chunks.enumerate().for_each(|(p, chunk)| {
-                if let Some(r) = &responses[p] {
-                    for (a, s) in sys.slots(p).enumerate() {
-                        chunk[a] = P::Formulation::map_gradient(r, &sys.grads[s]);
-                    }
-                }
-            });
-        }
-        Ok(())
     }
 
     /// The basis gradients of the force and stiffness: the step's, or
@@ -364,6 +525,10 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         points: &PointsOf<D, P>,
         norms: bool,
     ) -> Result<(), StepFailure> {
+        if !self.it.responses_current {
+            // After the fused pass or a failed update.
+            self.material_pass::<false>(points, false)?;
+        }
         let coupled = <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS;
         let (law, alpha) = (&self.law, &self.patches.alpha);
         let it = &mut self.it;
@@ -527,6 +692,35 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         self.it.stiffness_assembled = true;
     }
 
+    /// Stages 4b and 4d in one pass over the nodes
+    /// ([`crate::stages::gather::internal_force_and_stiffness`]) for an
+    /// iteration whose tangents came with the update
+    /// ([`Self::update_material_points_with_tangents`]): the numbers of
+    /// [`Self::assemble_internal_force`] and [`Self::assemble_stiffness`]
+    /// bit for bit, each point-node pair read once.
+    pub fn assemble_internal_force_and_stiffness(&mut self) {
+        let mut f_int = std::mem::take(&mut self.it.f_int);
+        let mut values = std::mem::take(&mut self.it.values);
+        gather::internal_force_and_stiffness(
+            &self.system,
+            self.force_gradients(),
+            &self.it.stress_w,
+            &self.it.tangent_w,
+            &mut f_int,
+            &mut values,
+        );
+        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+            gather::patch_coupling(&self.system, &self.patches, &mut values);
+        }
+        if !self.ghost.is_empty() {
+            self.ghost.add_force::<D>(&self.it.du, &mut f_int);
+            self.ghost.add_stiffness(&self.system, &mut values);
+        }
+        self.it.f_int = f_int;
+        self.it.values = values;
+        self.it.stiffness_assembled = true;
+    }
+
     /// Stage 4e: solve $K\,\delta d = -f^R$ (eq. 26) with the linear
     /// solver and accumulate the increment (eq. 30).
     pub fn solve(&mut self) -> Result<(), LinearSolveError> {
@@ -553,7 +747,14 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
 
     /// Stage 5: positions (eq. 31), converged deformation and stresses,
     /// volumes (eq. 22) and domains ([`crate::stages::update::commit`]).
+    /// The responses are those of the last update; after
+    /// [`Self::update_material_points_with_tangents`], which keeps none,
+    /// they are recomputed at the same increment first.
     pub fn commit(&mut self, points: &mut PointsOf<D, P>) -> Result<(), SolverError> {
+        if !self.it.responses_current {
+            self.material_pass::<false>(points, false)
+                .map_err(|cause| SolverError::Commit { cause })?;
+        }
         grid_to_point::commit(
             &self.system,
             &self.it.du,

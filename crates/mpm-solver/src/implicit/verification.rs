@@ -68,10 +68,30 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         Ok(k)
     }
 
-    /// One Newton iteration's assembly at `du_free`: material update,
-    /// internal force, consistent tangents and the sparse stiffness (what
-    /// the benchmarks time).
+    /// One Newton iteration's assembly at `du_free` as Newton runs it on
+    /// an iterate it expects to correct: material update with the
+    /// consistent tangents in one pass
+    /// ([`Self::update_material_points_with_tangents`]), internal force
+    /// and sparse stiffness in one pass over the nodes
+    /// ([`Self::assemble_internal_force_and_stiffness`]); what the
+    /// benchmarks time. Returns the normalised residual.
     pub fn assemble_at(
+        &mut self,
+        points: &PointsOf<D, P>,
+        du_free: &[f64],
+    ) -> Result<f64, StepFailure> {
+        self.set_free_increment(du_free);
+        self.update_material_points_with_tangents(points)?;
+        self.assemble_internal_force_and_stiffness();
+        Ok(self.normalised_residual())
+    }
+
+    /// [`Self::assemble_at`] through the separate stages: the update
+    /// keeping every response, the internal force, the tangents from the
+    /// stored responses, the stiffness (as Newton runs an iterate it
+    /// expected to converge but must correct). The same numbers bit for
+    /// bit.
+    pub fn assemble_in_stages_at(
         &mut self,
         points: &PointsOf<D, P>,
         du_free: &[f64],

@@ -133,6 +133,13 @@ pub fn rounding_noise<const D: usize>(
 /// the rounding floor).
 pub const STALL_RATIO: f64 = 0.5;
 
+/// How far above the convergence target the residual predicted by
+/// [`NewtonMonitor::expects_correction`] must lie before the next
+/// iteration is expected to need a correction. A wrong "yes" costs a
+/// tangent pass and a repeated update; a wrong "no" only the stored
+/// responses the fused pass saves, so the prediction leans towards "no".
+pub const CORRECTION_MARGIN: f64 = 100.0;
+
 /// What the convergence test says after an iteration.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Verdict {
@@ -169,6 +176,7 @@ pub struct NewtonMonitor {
     floor_factor: f64,
     noise: f64,
     at_floor: bool,
+    first_correction: bool,
 }
 
 impl NewtonMonitor {
@@ -185,7 +193,17 @@ impl NewtonMonitor {
             floor_factor: 0.0,
             noise: 0.0,
             at_floor: false,
+            first_correction: true,
         }
+    }
+
+    /// Whether [`Self::expects_correction`] says yes before the first
+    /// check (the default). A solver says no after a step that converged
+    /// on its first iterate: steps that carry no load change, or whose
+    /// prediction is exact, come in runs.
+    pub fn expecting_first_correction(mut self, expect: bool) -> Self {
+        self.first_correction = expect;
+        self
     }
 
     /// Accept stalled iterates within `floor_factor` times the rounding
@@ -247,6 +265,34 @@ impl NewtonMonitor {
         Verdict::Continue
     }
 
+    /// Whether the next [`Self::check`] is expected to ask for another
+    /// correction, so that the update before it may as well compute the
+    /// tangents (`ImplicitSolver::update_material_points_with_tangents`).
+    /// The next residual is predicted from the rate of the last two,
+    /// $r_{k+1} \approx r_k\,(r_k/r_{k-1})^2$, which is Newton's quadratic
+    /// rate $r_{k+1} = C r_k^2$ with $C = r_k/r_{k-1}^2$ and understates a
+    /// linear rate; after one residual, $r_1 \approx r_0^2$; before any,
+    /// yes unless [`Self::expecting_first_correction`] said no. It must
+    /// exceed [`CORRECTION_MARGIN`] times the target (the
+    /// tolerance, or the accepted multiple of the rounding floor if
+    /// larger). No once the iteration limit is reached: the next check
+    /// cannot ask for a correction.
+    pub fn expects_correction(&self) -> bool {
+        if self.residuals.len() >= self.max_iterations {
+            return false;
+        }
+        let predicted = match *self.residuals.as_slice() {
+            [] => return self.first_correction,
+            [r0] => r0 * r0,
+            [.., prev, last] if prev > 0.0 => last * (last / prev).powi(2),
+            [.., last] => last,
+        };
+        let target = self
+            .tolerance
+            .max(self.floor_factor * self.rounding_floor());
+        predicted > CORRECTION_MARGIN * target
+    }
+
     /// The iteration about to be checked (0 before the first solve).
     pub fn iteration(&self) -> usize {
         self.residuals.len()
@@ -294,6 +340,63 @@ mod tests {
         assert_eq!(m.residuals(), &[0.5, 5e-11]);
         assert_eq!(ratio(0.0, 0.0), 0.0);
         assert_eq!(ratio(1.0, 0.0), f64::INFINITY);
+    }
+
+    #[test]
+    fn the_monitor_expects_a_correction_until_the_predicted_residual_is_near_the_target() {
+        assert_eq!(CORRECTION_MARGIN, 100.0, "the figures below assume it");
+        let mut m = NewtonMonitor::new(1e-9, 1e6, 4).with_rounding_floor(10.0);
+        // Nothing checked yet: the first iterate is corrected.
+        assert!(m.expects_correction());
+        // r_1 ≈ r_0² = 1e-2.
+        assert_eq!(m.check(0.1, 1.0), Verdict::Continue);
+        assert!(m.expects_correction());
+        // Quadratic: 1e-1, 2e-3 predicts 2e-3 · (2e-2)² = 8e-7 > 1e-7.
+        assert_eq!(m.check(2e-3, 1.0), Verdict::Continue);
+        assert!(m.expects_correction());
+        // 2e-3, 1e-6 predicts 2.5e-13: the next iterate should converge.
+        assert_eq!(m.check(1e-6, 1.0), Verdict::Continue);
+        assert!(!m.expects_correction());
+        // At the iteration limit the next check cannot continue.
+        assert_eq!(m.check(1e-8, 1.0), Verdict::Continue);
+        assert!(!m.expects_correction());
+
+        // Either side of the margin (tolerance 1e-9, so 1e-7): 1e-4 →
+        // 1.0001e-5 predicts 1.0003e-7; 1e-4 → 9e-6 predicts 7.3e-8.
+        let after = |r: &[f64]| {
+            let mut m = NewtonMonitor::new(1e-9, 1e6, 30);
+            for &x in r {
+                assert_eq!(m.check(x, 1.0), Verdict::Continue);
+            }
+            m.expects_correction()
+        };
+        assert!(after(&[1e-4, 1.0001e-5]));
+        assert!(!after(&[1e-4, 9e-6]));
+        assert!(!after(&[1e-4, 1e-6]));
+        // One residual: r_0² against 1e-7.
+        assert!(after(&[1e-3]));
+        assert!(!after(&[1e-4]));
+        // A solver that saw the last step converge on its first iterate
+        // expects the same of the next.
+        let m = NewtonMonitor::new(1e-9, 1e6, 30).expecting_first_correction(false);
+        assert!(!m.expects_correction());
+
+        // Stalling near the rounding floor (noise 1e-9 in a force of 1,
+        // factor 10, so residuals up to 1e-8 are accepted once stalled):
+        // 2e-8 → 1.5e-8 predicts 8.4e-9, below the accepted 1e-8 times the
+        // margin.
+        let mut m = NewtonMonitor::new(1e-12, 1e6, 30).with_rounding_floor(10.0);
+        assert_eq!(m.check(1.0, 1.0), Verdict::Continue);
+        m.set_rounding_noise(1e-9);
+        assert_eq!(m.check(2e-8, 1.0), Verdict::Continue);
+        assert_eq!(m.check(1.5e-8, 1.0), Verdict::Continue);
+        assert!(!m.expects_correction());
+        // Without the floor the same residuals predict another correction.
+        let mut m = NewtonMonitor::new(1e-12, 1e6, 30);
+        for r in [1.0, 2e-8, 1.5e-8] {
+            assert_eq!(m.check(r, 1.0), Verdict::Continue);
+        }
+        assert!(m.expects_correction());
     }
 
     #[test]

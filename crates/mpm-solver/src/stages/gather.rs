@@ -78,16 +78,28 @@ pub fn internal_force<const D: usize>(
 ) {
     f_int.par_chunks_mut(D).enumerate().for_each(|(v, f)| {
         f.iter_mut().for_each(|x| *x = 0.0);
-        for &(p, a) in &sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]] {
-            let s = p as usize * sys.stride + a as usize;
-            let sw = &stress_w[p as usize];
-            for i in 0..D {
-                for j in 0..D {
-                    f[i] += sw[(i, j)] * grads[s][j];
-                }
+        node_force(sys, grads, stress_w, v, f);
+    });
+}
+
+/// Adds node `v`'s internal force to `f`, its points in ascending order.
+#[inline(always)]
+fn node_force<const D: usize>(
+    sys: &StepSystem<D>,
+    grads: &[SVector<f64, D>],
+    stress_w: &[Matrix3<f64>],
+    v: usize,
+    f: &mut [f64],
+) {
+    for &(p, a) in &sys.adj[sys.adj_ptr[v]..sys.adj_ptr[v + 1]] {
+        let s = p as usize * sys.stride + a as usize;
+        let sw = &stress_w[p as usize];
+        for i in 0..D {
+            for j in 0..D {
+                f[i] += sw[(i, j)] * grads[s][j];
             }
         }
-    });
+    }
 }
 
 /// A point's volume-weighted tangent on the components a `D`-dimensional
@@ -127,9 +139,42 @@ pub fn stiffness<const D: usize>(
     tangent_w: &[PointTangent<D>],
     values: &mut [f64],
 ) {
-    let block = |w: usize, vals: &mut [f64]| {
+    node_pass::<D, false>(sys, grads, tangent_w, &[], values, &mut []);
+}
+
+/// [`internal_force`] and [`stiffness`] in one pass over the nodes, for an
+/// iteration whose tangents are known before its convergence test (the
+/// same sums in the same order, so the same numbers bit for bit): each
+/// point-node pair is read once for both.
+pub fn internal_force_and_stiffness<const D: usize>(
+    sys: &StepSystem<D>,
+    grads: &[SVector<f64, D>],
+    stress_w: &[Matrix3<f64>],
+    tangent_w: &[PointTangent<D>],
+    f_int: &mut [f64],
+    values: &mut [f64],
+) {
+    node_pass::<D, true>(sys, grads, tangent_w, stress_w, values, f_int);
+}
+
+/// The stiffness, with the internal force when `FORCE`.
+fn node_pass<const D: usize, const FORCE: bool>(
+    sys: &StepSystem<D>,
+    grads: &[SVector<f64, D>],
+    tangent_w: &[PointTangent<D>],
+    stress_w: &[Matrix3<f64>],
+    values: &mut [f64],
+    f_int: &mut [f64],
+) {
+    let block = |w: usize, vals: &mut [f64], f: &mut [f64]| {
+        if FORCE {
+            f.iter_mut().for_each(|x| *x = 0.0);
+        }
         if vals.is_empty() {
             // Every dof of w is prescribed: no column to assemble.
+            if FORCE {
+                node_force(sys, grads, stress_w, w, f);
+            }
             return;
         }
         vals.iter_mut().for_each(|x| *x = 0.0);
@@ -141,6 +186,14 @@ pub fn stiffness<const D: usize>(
             let p = p as usize;
             let t = &tangent_w[p];
             let gw = &grads[p * sys.stride + b as usize];
+            if FORCE {
+                let sw = &stress_w[p];
+                for i in 0..D {
+                    for j in 0..D {
+                        f[i] += sw[(i, j)] * gw[j];
+                    }
+                }
+            }
             // q[i][j][k] = Σ_l T_(ij)(kl) g_w,l
             let mut q = [[[0.0f64; D]; D]; D];
             for i in 0..D {
@@ -197,7 +250,17 @@ pub fn stiffness<const D: usize>(
             }
         }
     };
-    split_blocks(0, sys.n_active(), values, 0, &sys.block_ptr, &block);
+    let per_node = if FORCE { D } else { 0 };
+    split_blocks(
+        0,
+        sys.n_active(),
+        values,
+        0,
+        f_int,
+        per_node,
+        &sys.block_ptr,
+        &block,
+    );
 }
 
 /// Adds the patch coupling of a locking treatment to a stiffness
@@ -241,7 +304,16 @@ pub fn patch_coupling<const D: usize>(
             }
         }
     };
-    split_blocks(0, sys.n_active(), values, 0, &sys.block_ptr, &block);
+    split_blocks(
+        0,
+        sys.n_active(),
+        values,
+        0,
+        &mut [],
+        0,
+        &sys.block_ptr,
+        &|w, v, _| block(w, v),
+    );
 }
 
 /// Adds the coupling `gv · q` of one row node through its block-map rows
@@ -267,29 +339,54 @@ fn scatter_wide<const D: usize>(
     }
 }
 
-/// Runs `f(w, values_of_block_w)` for the block columns `lo..hi` in
-/// parallel, splitting `vals` (which starts at block `lo`, value index
-/// `base`) into disjoint slices at block boundaries.
-fn split_blocks<F>(lo: usize, hi: usize, vals: &mut [f64], base: usize, block_ptr: &[usize], f: &F)
-where
-    F: Fn(usize, &mut [f64]) + Sync,
+/// Runs `f(w, values_of_block_w, nodal_of_w)` for the block columns
+/// `lo..hi` in parallel, splitting `vals` (which starts at block `lo`,
+/// value index `base`) into disjoint slices at block boundaries, and
+/// `nodal` (which starts at node `lo`) into `per_node` values per node
+/// (`per_node = 0` with an empty `nodal` when there is nothing per node).
+#[allow(clippy::too_many_arguments)]
+fn split_blocks<F>(
+    lo: usize,
+    hi: usize,
+    vals: &mut [f64],
+    base: usize,
+    nodal: &mut [f64],
+    per_node: usize,
+    block_ptr: &[usize],
+    f: &F,
+) where
+    F: Fn(usize, &mut [f64], &mut [f64]) + Sync,
 {
     const GRAIN: usize = 64;
     if hi - lo <= GRAIN {
-        let mut rest = vals;
+        let (mut rest, mut nodal_rest) = (vals, nodal);
         for w in lo..hi {
             let len = block_ptr[w + 1] - block_ptr[w];
             let (head, tail) = rest.split_at_mut(len);
-            f(w, head);
+            let (node, nodal_tail) = nodal_rest.split_at_mut(per_node);
+            f(w, head, node);
             rest = tail;
+            nodal_rest = nodal_tail;
         }
         return;
     }
     let mid = (lo + hi) / 2;
     let (left, right) = vals.split_at_mut(block_ptr[mid] - base);
+    let (nodal_left, nodal_right) = nodal.split_at_mut(per_node * (mid - lo));
     rayon::join(
-        || split_blocks(lo, mid, left, base, block_ptr, f),
-        || split_blocks(mid, hi, right, block_ptr[mid], block_ptr, f),
+        || split_blocks(lo, mid, left, base, nodal_left, per_node, block_ptr, f),
+        || {
+            split_blocks(
+                mid,
+                hi,
+                right,
+                block_ptr[mid],
+                nodal_right,
+                per_node,
+                block_ptr,
+                f,
+            )
+        },
     );
 }
 
