@@ -62,7 +62,7 @@ fn lap(clock: Instant) -> f64 {
 use crate::locking::LockingTreatment;
 use crate::parts::{PointsOf, SolverParts};
 use crate::stages::convergence::{self, NewtonMonitor, Verdict};
-use crate::stages::gather::PointTangent;
+use crate::stages::gather::{PointStress, PointTangent};
 use crate::stages::ghost::GhostFaces;
 use crate::stages::patch::PatchSystem;
 use crate::stages::system::StepSystem;
@@ -79,7 +79,8 @@ struct Iterate<const D: usize, H> {
     /// `responses` belong to the current increment `du` (false after the
     /// fused update-with-tangents pass and after a failed update).
     responses_current: bool,
-    stress_w: Vec<Matrix3<f64>>,
+    /// Per point, the weighted stress's components in use.
+    stress_w: Vec<PointStress<D>>,
     /// Per point, the weighted tangent's components in use.
     tangent_w: Vec<PointTangent<D>>,
     /// Per point, $\|T_p\|_F$ of the full weighted tangent, when the

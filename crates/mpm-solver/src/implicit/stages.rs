@@ -18,6 +18,7 @@ use crate::linear::LinearSolveError;
 use crate::locking::{LockingTreatment, PatchInput};
 use crate::mesh::NodalMesh;
 use crate::parts::{PointsOf, SolverParts};
+use crate::stages::gather::PointStress;
 use crate::stages::patch::PatchSystem;
 use crate::stages::system::{NONE, StepSystem};
 use crate::stages::{basis, gather, update as grid_to_point};
@@ -115,10 +116,11 @@ impl<const D: usize, P: SolverParts<D>> PointPass<'_, D, P> {
         &self,
         p: usize,
         r: &Response<P::History>,
-        stress: &mut Matrix3<f64>,
+        stress: &mut PointStress<D>,
         chunk: &mut [SVector<f64, D>],
     ) {
-        *stress = P::Formulation::stress(r) * P::Formulation::volume(r, self.points.volume[p]);
+        let s = P::Formulation::stress(r) * P::Formulation::volume(r, self.points.volume[p]);
+        *stress = s.fixed_view::<D, D>(0, 0).into_owned();
         if <P::Formulation as Formulation>::MAPS_GRADIENTS {
             for (a, s) in self.sys.slots(p).enumerate() {
                 chunk[a] = P::Formulation::map_gradient(r, &self.sys.grads[s]);
@@ -370,7 +372,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let sys = &self.system;
         let it = &mut self.it;
         let maps_gradients = <P::Formulation as Formulation>::MAPS_GRADIENTS;
-        it.stress_w.resize(n, Matrix3::zeros());
+        it.stress_w.resize(n, PointStress::<D>::zeros());
         if maps_gradients {
             it.mapped.resize(sys.grads.len(), SVector::zeros());
         }

@@ -7,7 +7,7 @@
 //! order, so the result is bit-identical for any number of threads.
 
 use mpm_constitutive::tensor::{Tensor4, idx};
-use nalgebra::{Matrix3, SVector};
+use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 
 use crate::points::MaterialPoints;
@@ -73,7 +73,7 @@ pub fn external_force<const D: usize, H, Dom>(
 pub fn internal_force<const D: usize>(
     sys: &StepSystem<D>,
     grads: &[SVector<f64, D>],
-    stress_w: &[Matrix3<f64>],
+    stress_w: &[PointStress<D>],
     f_int: &mut [f64],
 ) {
     f_int.par_chunks_mut(D).enumerate().for_each(|(v, f)| {
@@ -87,7 +87,7 @@ pub fn internal_force<const D: usize>(
 fn node_force<const D: usize>(
     sys: &StepSystem<D>,
     grads: &[SVector<f64, D>],
-    stress_w: &[Matrix3<f64>],
+    stress_w: &[PointStress<D>],
     v: usize,
     f: &mut [f64],
 ) {
@@ -101,6 +101,12 @@ fn node_force<const D: usize>(
         }
     }
 }
+
+/// A point's volume-weighted stress on the components the internal force
+/// reads: $f^{int}_{v,i} = \sum_p s_{ij}\nabla_j S_{vp}$ with basis
+/// gradients that have no out-of-plane component, so plane strain reads
+/// the in-plane $2\times 2$ block (3D all nine).
+pub type PointStress<const D: usize> = SMatrix<f64, D, D>;
 
 /// A point's volume-weighted tangent on the components a `D`-dimensional
 /// problem reads, `t[i][j][k][l]` $= T_{ijkl}$ for $i, j, k, l < D$: the
@@ -149,7 +155,7 @@ pub fn stiffness<const D: usize>(
 pub fn internal_force_and_stiffness<const D: usize>(
     sys: &StepSystem<D>,
     grads: &[SVector<f64, D>],
-    stress_w: &[Matrix3<f64>],
+    stress_w: &[PointStress<D>],
     tangent_w: &[PointTangent<D>],
     f_int: &mut [f64],
     values: &mut [f64],
@@ -162,7 +168,7 @@ fn node_pass<const D: usize, const FORCE: bool>(
     sys: &StepSystem<D>,
     grads: &[SVector<f64, D>],
     tangent_w: &[PointTangent<D>],
-    stress_w: &[Matrix3<f64>],
+    stress_w: &[PointStress<D>],
     values: &mut [f64],
     f_int: &mut [f64],
 ) {
@@ -209,24 +215,19 @@ fn node_pass<const D: usize, const FORCE: bool>(
             }
             let start = p * sys.stride;
             let m = sys.counts[p] as usize;
-            let row = sys
-                .slot_offset_ptr
-                .get(p)
-                .map(|&ptr| &sys.slot_offset[ptr + b as usize * m..ptr + (b as usize + 1) * m]);
-            for s in sys.slots(p) {
-                let gv = &grads[s];
-                let entry = match row {
-                    Some(row) => row[s - start],
-                    None => match nbs.binary_search(&sys.nodes[s]) {
-                        Ok(pos) => {
-                            // Wider than the table: place each entry
-                            // through the block map.
-                            scatter_wide(&map[pos * D * D..(pos + 1) * D * D], gv, &q, vals);
-                            continue;
-                        }
-                        Err(_) => NO_ENTRY,
-                    },
-                };
+            let point_grads = &grads[start..start + m];
+            let Some(&ptr) = sys.slot_offset_ptr.get(p) else {
+                // Wider than the table: place each entry through the block
+                // map.
+                for (gv, node) in point_grads.iter().zip(&sys.nodes[start..start + m]) {
+                    if let Ok(pos) = nbs.binary_search(node) {
+                        scatter_wide(&map[pos * D * D..(pos + 1) * D * D], gv, &q, vals);
+                    }
+                }
+                continue;
+            };
+            let row = &sys.slot_offset[ptr + b as usize * m..ptr + (b as usize + 1) * m];
+            for (gv, &entry) in point_grads.iter().zip(row) {
                 if entry == NO_ENTRY {
                     continue;
                 }
