@@ -188,6 +188,8 @@ fn node_pass<const D: usize, const FORCE: bool>(
         let map = &sys.block_map[sys.nb_ptr[w] * D * D..sys.nb_ptr[w + 1] * D * D];
         // Column length of a block whose D columns are all present.
         let column = vals.len() / D;
+        // The node's force, summed in registers.
+        let mut force = [0.0f64; D];
         for &(p, b) in &sys.adj[sys.adj_ptr[w]..sys.adj_ptr[w + 1]] {
             let p = p as usize;
             let t = &tangent_w[p];
@@ -196,7 +198,7 @@ fn node_pass<const D: usize, const FORCE: bool>(
                 let sw = &stress_w[p];
                 for i in 0..D {
                     for j in 0..D {
-                        f[i] += sw[(i, j)] * gw[j];
+                        force[i] += sw[(i, j)] * gw[j];
                     }
                 }
             }
@@ -249,6 +251,9 @@ fn node_pass<const D: usize, const FORCE: bool>(
                 let pos = (entry & !PARTIAL) as usize;
                 scatter_wide(&map[pos * D * D..(pos + 1) * D * D], gv, &q, vals);
             }
+        }
+        if FORCE {
+            f.copy_from_slice(&force);
         }
     };
     let per_node = if FORCE { D } else { 0 };
