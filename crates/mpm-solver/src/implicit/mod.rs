@@ -291,7 +291,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             }
             let clock = Instant::now();
             if !fused {
-                self.update_tangents_with::<false>(points, first)
+                self.update_tangents_with(points, false, first)
                     .map_err(|cause| retry(cause, &monitor))?;
             }
             if first {

@@ -355,7 +355,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     ) -> Result<(), StepFailure> {
         if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
             self.material_pass::<false>(points, false)?;
-            self.update_tangents_with::<false>(points, norms)
+            self.update_tangents_with(points, false, norms)
         } else {
             self.material_pass::<true>(points, norms)
         }
@@ -509,22 +509,26 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// Stage 4c: the formulation's consistent tangent at every point,
     /// weighted by its integration volume.
     pub fn update_tangents(&mut self, points: &PointsOf<D, P>) -> Result<(), StepFailure> {
-        self.update_tangents_with::<false>(points, false)
+        self.update_tangents_with(points, false, false)
     }
 
     /// [`Self::update_tangents`] with each law's algorithmic tangent
-    /// (`LOADING = false`) or its tangent for continued loading
-    /// (`LogStrainLaw::loading_tangent`, `LOADING = true`), which differ
-    /// only for points on a yield surface. With `norms`, also the
+    /// (`loading = false`) or its tangent for continued loading
+    /// (`LogStrainLaw::loading_tangent`, `loading = true`), which differ
+    /// only for points on a yield surface. (A run-time flag rather than a
+    /// const parameter: one instantiation per solver type less to compile,
+    /// for a branch per point that is always predicted.) With `norms`,
+    /// also the
     /// Frobenius norm of each full weighted tangent as the stiffness uses
     /// it (for [`convergence::rounding_noise`]).
     ///
     /// Each point's $9\times 9$ tangent is read where the law leaves it
     /// and only the `D`-dimensional components the later stages use are
     /// kept ([`gather::PointTangent`]).
-    pub(super) fn update_tangents_with<const LOADING: bool>(
+    pub(super) fn update_tangents_with(
         &mut self,
         points: &PointsOf<D, P>,
+        loading: bool,
         norms: bool,
     ) -> Result<(), StepFailure> {
         if !self.it.responses_current {
@@ -549,7 +553,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 let volume = P::Formulation::volume(r, points.volume[p]);
                 // Read in place: moving the tensor out of its `Result` is a
                 // 648-byte copy the compiler does not elide.
-                let tangent = if LOADING {
+                let tangent = if loading {
                     <P::Formulation as Formulation>::Tangent::loading_tangent(law, r)
                 } else {
                     <P::Formulation as Formulation>::Tangent::tangent(law, r)
@@ -603,7 +607,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let f0 = self.it.f_int.clone();
         // The points that yielded in the last step sit on the yield
         // surface; the increment continues their loading.
-        self.update_tangents_with::<true>(points, false)?;
+        self.update_tangents_with(points, true, false)?;
         self.assemble_stiffness();
         let eps = LINEARISED_START_STEP;
         for (u, p) in self.it.du.iter_mut().zip(&prescribed) {
