@@ -518,9 +518,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// only for points on a yield surface. (A run-time flag rather than a
     /// const parameter: one instantiation per solver type less to compile,
     /// for a branch per point that is always predicted.) With `norms`,
-    /// also the
-    /// Frobenius norm of each full weighted tangent as the stiffness uses
-    /// it (for [`convergence::rounding_noise`]).
+    /// also the Frobenius norm of each full weighted tangent as the
+    /// stiffness uses it (for [`convergence::rounding_noise`]).
     ///
     /// Each point's $9\times 9$ tangent is read where the law leaves it
     /// and only the `D`-dimensional components the later stages use are
