@@ -12,7 +12,7 @@
 //! | [`explicit::DilatationTreatment`] (explicit) | [`NoLocking`], [`CellAveraged`] | MPoint notes eqs. 47–53 |
 //! | [`Formulation`] | [`UpdatedLagrangian`], [`PreviouslyConverged`] | §3, §5 |
 //! | [`LockingTreatment`] | [`NoLocking`], [`FBar`], [`FPatch`] | Wang et al. 2021 §3.2; Coombs et al. 2018 |
-//! | [`DomainUpdater`] (or the shorter [`DeformationRule`]) | [`NoUpdate`], [`DetF`], [`DiagF`], [`StretchU`], [`CornerMidpoint`], [`Midpoint`], [`VolumeCorrectedDiagF`], [`IncrementalVolumeCorrectedDiagF`], [`ConvectedCorners`], [`DomainVolume`] | Coombs et al. 2020 §6.4 |
+//! | [`DomainUpdater`] (or the shorter [`DeformationRule`]) | [`NoUpdate`], [`DetF`], [`DiagF`], [`StretchU`], [`CornerMidpoint`], [`Midpoint`], [`VolumeCorrectedDiagF`], [`IncrementalVolumeCorrectedDiagF`], [`ConvectedCorners`], [`DomainVolume`]; [`AnyGimpRule`] chooses among the GIMP rules at run time | Coombs et al. 2020 §6.4 |
 //! | [`Constraints`] | [`NodalConstraints`], [`MovingMesh`] | §6.2; Wang et al. 2021 §5.3 |
 //! | [`LinearSolver`] | [`FaerDirect`] | eq. 26 |
 //!
@@ -87,8 +87,8 @@ pub mod stepping;
 pub use boundary::{Constraints, NodalConstraints, StepView};
 pub use checkpoint::Flat;
 pub use domain::{
-    ConvectedCorners, CornerMidpoint, DeformationRule, DetF, DiagF, DisplacementField,
-    DomainContext, DomainError, DomainUpdater, DomainVolume, GimpContext,
+    AnyGimpRule, ConvectedCorners, CornerMidpoint, DeformationRule, DetF, DiagF, DisplacementField,
+    DomainContext, DomainError, DomainUpdater, DomainVolume, GimpContext, GimpRule,
     IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, StretchU, VolumeCorrectedDiagF,
 };
 pub use error::{

@@ -63,9 +63,20 @@ pub struct PatchInput<'a, const D: usize> {
 pub trait LockingTreatment<const D: usize, M>: Send + Sync {
     /// Name used in outputs (`none`, `fbar`, `fpatch`).
     const NAME: &'static str;
-    /// Whether points are coupled through patches. When false the solver
-    /// never calls [`Self::assign`] and runs standard MPM's kernels.
+    /// Whether points of this type may be coupled through patches: the
+    /// value of [`Self::couples_points`] for every value of a typed
+    /// treatment (an upper bound for one chosen at run time).
     const COUPLES_POINTS: bool;
+
+    /// Whether this treatment couples points through patches. When false
+    /// the solver never calls [`Self::assign`] and runs standard MPM's
+    /// kernels. A typed treatment answers its constant (the branch folds
+    /// away); a treatment chosen at run time (`Option<K>`) answers per
+    /// value, once per stage.
+    #[inline(always)]
+    fn couples_points(&self) -> bool {
+        Self::COUPLES_POINTS
+    }
 
     /// Writes the patch and weight of every point at the start of a load
     /// step into `out` (resized to the number of points).
@@ -97,6 +108,33 @@ impl<const D: usize, M> LockingTreatment<D, M> for NoLocking {
         out.patch.clear();
         out.weight.clear();
         Ok(())
+    }
+}
+
+/// A treatment chosen at run time: `None` is standard MPM
+/// ([`NoLocking`]), `Some(k)` is `k`. The scene runner compiles one
+/// solver for both instead of one per treatment; the choice is a branch
+/// per stage, never per point and node. [`LockingTreatment::NAME`] is
+/// `K`'s.
+impl<const D: usize, M, K: LockingTreatment<D, M>> LockingTreatment<D, M> for Option<K> {
+    const NAME: &'static str = K::NAME;
+    const COUPLES_POINTS: bool = K::COUPLES_POINTS;
+
+    #[inline(always)]
+    fn couples_points(&self) -> bool {
+        self.as_ref().is_some_and(K::couples_points)
+    }
+
+    fn assign(
+        &mut self,
+        mesh: &M,
+        input: PatchInput<'_, D>,
+        out: &mut PatchAssignment,
+    ) -> Result<(), LockingError> {
+        match self {
+            Some(k) => k.assign(mesh, input, out),
+            None => NoLocking.assign(mesh, input, out),
+        }
     }
 }
 

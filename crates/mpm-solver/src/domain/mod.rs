@@ -9,6 +9,7 @@ mod convected_corners;
 mod det_f;
 mod diag_f;
 mod domain_volume;
+mod gimp_rule;
 mod incremental_volume_corrected_diag_f;
 mod midpoint;
 mod none;
@@ -19,6 +20,7 @@ pub use convected_corners::ConvectedCorners;
 pub use det_f::DetF;
 pub use diag_f::DiagF;
 pub use domain_volume::DomainVolume;
+pub use gimp_rule::{AnyGimpRule, GimpRule};
 pub use incremental_volume_corrected_diag_f::IncrementalVolumeCorrectedDiagF;
 pub use midpoint::{CornerMidpoint, Midpoint};
 pub use none::NoUpdate;
@@ -184,6 +186,12 @@ pub trait DomainUpdater<const D: usize, Dom>: Send + Sync {
     #[inline]
     fn volume(&self, _domain: &Dom, f_volume: f64) -> f64 {
         f_volume
+    }
+
+    /// The rule's name in outputs and errors: [`Self::NAME`], or the rule
+    /// a run-time choice holds ([`AnyGimpRule`]).
+    fn name(&self) -> &'static str {
+        Self::NAME
     }
 }
 

@@ -874,7 +874,7 @@ where
             )
         })
         .map_err(|source| PointFailure::Domain {
-            rule: R::NAME,
+            rule: rule.name(),
             source: Box::new(source),
         })?;
     *domain = updated;

@@ -257,8 +257,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             // Where Newton expects to correct this iterate, its tangents
             // come with the update (a coupled treatment gains nothing: it
             // keeps the responses for its patch terms).
-            let fused = !<P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS
-                && monitor.expects_correction();
+            let fused = !self.locking.couples_points() && monitor.expects_correction();
             fused_updates += usize::from(fused);
             let clock = Instant::now();
             match self.update_material_points_backtracking(

@@ -62,6 +62,8 @@ struct PointPass<'a, const D: usize, P: SolverParts<D>> {
     increments: &'a [Matrix3<f64>],
     points: &'a PointsOf<D, P>,
     limit: f64,
+    /// The locking treatment couples points ([`LockingTreatment::couples_points`]).
+    coupled: bool,
 }
 
 impl<const D: usize, P: SolverParts<D>> PointPass<'_, D, P> {
@@ -77,7 +79,7 @@ impl<const D: usize, P: SolverParts<D>> PointPass<'_, D, P> {
     ) -> Option<StepFailure> {
         // The motion's ΔF (eq. 7), or the patch-averaged ΔF̄ the law sees
         // under a coupled treatment (Wang et al. eq. 9).
-        let delta_f = if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+        let delta_f = if self.coupled {
             self.patches.modified(p, &self.increments[p])
         } else {
             grid_to_point::deformation_increment(self.sys, self.du, p)
@@ -203,7 +205,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             ghost.clear();
         }
         let ghost = &self.ghost;
-        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+        if self.locking.couples_points() {
             let input = PatchInput {
                 position: &points.position,
                 cells: &self.hints,
@@ -219,7 +221,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         if !ghost.is_empty() {
             sys.extend_neighbours(|w, push| ghost.partners(w, push));
         }
-        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+        if self.locking.couples_points() {
             self.patches.build_placement(sys);
         }
         let (support, stiffness) = gather::support_weights(sys, volumes);
@@ -260,8 +262,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         it.values.clear();
         it.values.resize(sys.row_idx.len(), 0.0);
         it.stiffness_assembled = false;
-        let symmetric = <P::Law as LogStrainLaw>::SYMMETRIC_TANGENT
-            && !<P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS;
+        let symmetric =
+            <P::Law as LogStrainLaw>::SYMMETRIC_TANGENT && !self.locking.couples_points();
         self.analysed = false;
         self.linear
             .analyse(sys.n_free, &sys.col_ptr, &sys.row_idx, symmetric)
@@ -353,7 +355,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         points: &PointsOf<D, P>,
         norms: bool,
     ) -> Result<(), StepFailure> {
-        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+        if self.locking.couples_points() {
             self.material_pass::<false>(points, false)?;
             self.update_tangents_with(points, false, norms)
         } else {
@@ -386,7 +388,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             it.responses.resize(n, None);
         }
         let du = &it.du;
-        let coupled = <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS;
+        let coupled = self.locking.couples_points();
         if coupled {
             it.increments.resize(n, Matrix3::identity());
             it.increments
@@ -425,6 +427,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             increments,
             points,
             limit,
+            coupled,
         };
         let failure = if TANGENTS {
             it.stress_w
@@ -534,7 +537,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             // After the fused pass or a failed update.
             self.material_pass::<false>(points, false)?;
         }
-        let coupled = <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS;
+        let coupled = self.locking.couples_points();
         let (law, alpha) = (&self.law, &self.patches.alpha);
         let it = &mut self.it;
         let n = it.responses.len();
@@ -687,7 +690,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             &self.it.tangent_w,
             &mut values,
         );
-        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+        if self.locking.couples_points() {
             gather::patch_coupling(&self.system, &self.patches, &mut values);
         }
         if !self.ghost.is_empty() {
@@ -714,7 +717,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             &mut f_int,
             &mut values,
         );
-        if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS {
+        if self.locking.couples_points() {
             gather::patch_coupling(&self.system, &self.patches, &mut values);
         }
         if !self.ghost.is_empty() {
