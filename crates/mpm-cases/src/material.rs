@@ -1,13 +1,24 @@
 //! The constitutive laws reachable from scene files and the command line,
-//! chosen by name and dispatched to a fully monomorphised computation.
+//! chosen by name at run time.
+//!
+//! A scene's materials run as one [`SceneLaws`]: a
+//! [`MaterialSet`] of [`SceneLaw`]s, the enum over the registered laws,
+//! whose history [`SceneHistory`] is the enum over their histories. The
+//! law is chosen per point by a `match` beside the stress update (one
+//! predictable branch per point), so every scene of a dimension, basis
+//! and formulation runs one compiled solver whatever its materials; each
+//! arm calls the typed law, so the numbers are those of the typed solver
+//! bit for bit.
 //!
 //! A new law is one file in `mpm-constitutive` (an implementation of
 //! `LogStrainLaw`) and one line in the [`register_laws!`] call below.
 
 use mpm_constitutive::{
-    HenckyElastic, LogStrainLaw, MaterialSet, NeoHookean, Tagged, VonMises, VonMisesHistory,
+    HenckyElastic, IsotropicElasticity, LawState, LogStrainLaw, MaterialSet, NeoHookean,
+    SymSpectral, Tensor4, VonMises,
 };
 use mpm_solver::{Flat, SolverError};
+use nalgebra::Vector3;
 
 use crate::run::HistoryOutput;
 
@@ -24,107 +35,256 @@ pub struct MaterialParams {
     pub hardening: f64,
 }
 
-/// The initial history of a point of material `material` (an index into
-/// the scene's materials): the law's default history, tagged with the
-/// material when the law is a [`MaterialSet`].
-pub trait MaterialTag {
-    /// The history a point of `material` starts with.
-    fn for_material(material: u32) -> Self;
-    /// The material a history belongs to (0 for laws of one material).
-    fn material(&self) -> u32;
+/// The laws of a scene's materials: material `k` is law `k`, each point's
+/// history tagged with its material.
+pub type SceneLaws = MaterialSet<SceneLaw>;
+
+/// The largest of `lens` (a `const` helper for [`SceneHistory`]'s length).
+const fn max_len(lens: &[usize]) -> usize {
+    let (mut k, mut m) = (0, 0);
+    while k < lens.len() {
+        if lens[k] > m {
+            m = lens[k];
+        }
+        k += 1;
+    }
+    m
 }
 
-impl MaterialTag for () {
-    fn for_material(_: u32) -> Self {}
-    fn material(&self) -> u32 {
-        0
-    }
-}
-
-impl MaterialTag for VonMisesHistory {
-    fn for_material(_: u32) -> Self {
-        Self::default()
-    }
-    fn material(&self) -> u32 {
-        0
-    }
-}
-
-impl<H: Default> MaterialTag for Tagged<H> {
-    fn for_material(material: u32) -> Self {
-        Tagged::new(material, H::default())
-    }
-    fn material(&self) -> u32 {
-        self.material
-    }
-}
-
-/// A computation generic over the law; [`dispatch_law`] calls it with the
-/// law a [`MaterialModel`] names, [`dispatch_law_set`] with a
-/// [`MaterialSet`] of them.
-pub trait LawVisitor {
-    /// What the computation returns.
-    type Output;
-
-    /// Runs with law `law`.
-    fn visit<L>(self, law: L) -> Self::Output
-    where
-        L: LogStrainLaw,
-        L::History: HistoryOutput + Flat + MaterialTag;
-}
-
-/// One line per law: the variant, its name in scene files, and how the law
-/// is built from [`MaterialParams`] `$p`.
+/// One line per law: the variant, its name in scene files, the
+/// `mpm-constitutive` type, and how it is built from [`MaterialParams`]
+/// `$p`.
 macro_rules! register_laws {
-    ($($(#[$doc:meta])* $variant:ident => $text:literal, |$p:ident| $make:expr;)+) => {
+    ($($(#[$doc:meta])* $variant:ident => $text:literal, $ty:ty, |$p:ident| $make:expr;)+) => {
         crate::variant::named_enum!(
             /// Constitutive models (mpm-constitutive).
             MaterialModel { $($(#[$doc])* $variant => $text),+ }
         );
 
-        /// Builds the law `model` names from `params` and calls `visitor`
-        /// with it.
-        ///
-        /// # Errors
-        /// [`SolverError::Material`] for invalid parameters,
-        /// [`SolverError::InvalidInput`] for a parameter the model needs
-        /// but was not given.
-        pub fn dispatch_law<V: LawVisitor>(
-            model: MaterialModel,
-            params: &MaterialParams,
-            visitor: V,
-        ) -> Result<V::Output, SolverError> {
-            match model {
-                $(MaterialModel::$variant => {
-                    let $p = params;
-                    Ok(visitor.visit($make?))
-                })+
+        /// One of the registered laws, chosen at run time (module docs).
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum SceneLaw {
+            $($(#[$doc])* $variant($ty)),+
+        }
+
+        /// The history of a [`SceneLaw`]: the variant of its law. A
+        /// history of another variant (the default, before a point's
+        /// first update) reads as the law's default history.
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub enum SceneHistory {
+            $($(#[$doc])* $variant(<$ty as LogStrainLaw>::History)),+
+        }
+
+        impl SceneLaw {
+            /// Builds the law `model` names from `params`.
+            ///
+            /// # Errors
+            /// [`SolverError::Material`] for invalid parameters,
+            /// [`SolverError::InvalidInput`] for a parameter the model
+            /// needs but was not given.
+            pub fn new(model: MaterialModel, params: &MaterialParams) -> Result<Self, SolverError> {
+                Ok(match model {
+                    $(MaterialModel::$variant => {
+                        let $p = params;
+                        SceneLaw::$variant($make?)
+                    })+
+                })
+            }
+
+            /// The model this law is.
+            pub fn model(&self) -> MaterialModel {
+                match self {
+                    $(SceneLaw::$variant(_) => MaterialModel::$variant,)+
+                }
+            }
+
+            /// The history a point of this law starts with.
+            pub fn initial_history(&self) -> SceneHistory {
+                match self {
+                    $(SceneLaw::$variant(_) => SceneHistory::$variant(Default::default()),)+
+                }
             }
         }
 
-        /// Builds one law of `model` per entry of `params` and calls
-        /// `visitor` with their [`MaterialSet`] (material `k` is
-        /// `params[k]`).
-        ///
-        /// # Errors
-        /// As [`dispatch_law`], and [`SolverError::Material`] for an empty
-        /// `params`.
-        pub fn dispatch_law_set<V: LawVisitor>(
-            model: MaterialModel,
-            params: &[MaterialParams],
-            visitor: V,
-        ) -> Result<V::Output, SolverError> {
-            match model {
-                $(MaterialModel::$variant => {
-                    let laws = params
-                        .iter()
-                        .map(|$p| -> Result<_, SolverError> { Ok($make?) })
-                        .collect::<Result<Vec<_>, _>>()?;
-                    Ok(visitor.visit(MaterialSet::new(laws)?))
-                })+
+        impl Default for SceneHistory {
+            /// The first registered law's default history.
+            fn default() -> Self {
+                register_laws!(@first $(SceneHistory::$variant(Default::default())),+)
+            }
+        }
+
+        impl HistoryOutput for SceneHistory {
+            fn equivalent_plastic_strain(&self) -> f64 {
+                match self {
+                    $(SceneHistory::$variant(h) => h.equivalent_plastic_strain(),)+
+                }
+            }
+        }
+
+        /// The variant's index, then its history's numbers, padded to the
+        /// longest history's.
+        impl Flat for SceneHistory {
+            const LEN: usize =
+                1 + max_len(&[$(<<$ty as LogStrainLaw>::History as Flat>::LEN),+]);
+
+            fn write(&self, out: &mut Vec<f64>) {
+                let start = out.len();
+                let mut index = 0.0;
+                $(
+                    if let SceneHistory::$variant(h) = self {
+                        out.push(index);
+                        h.write(out);
+                    }
+                    index += 1.0;
+                )+
+                let _ = index;
+                out.resize(start + Self::LEN, 0.0);
+            }
+
+            fn read(from: &[f64]) -> Self {
+                let mut index = 0.0;
+                $(
+                    if from[0] == index {
+                        return SceneHistory::$variant(Flat::read(&from[1..]));
+                    }
+                    index += 1.0;
+                )+
+                let _ = index;
+                // An index out of range (a checkpoint of another build)
+                // reads as the default history.
+                SceneHistory::default()
+            }
+        }
+
+        impl LogStrainLaw for SceneLaw {
+            type History = SceneHistory;
+
+            const SYMMETRIC_TANGENT: bool =
+                true $(&& <$ty as LogStrainLaw>::SYMMETRIC_TANGENT)+;
+
+            #[inline]
+            fn return_map(&self, trial: &SymSpectral, history: &SceneHistory) -> LawState<SceneHistory> {
+                match self {
+                    $(SceneLaw::$variant(law) => {
+                        #[allow(unreachable_patterns)]
+                        let h = match history {
+                            SceneHistory::$variant(h) => *h,
+                            _ => Default::default(),
+                        };
+                        let s = law.return_map(trial, &h);
+                        LawState {
+                            tau: s.tau,
+                            elastic_strain: s.elastic_strain,
+                            history: SceneHistory::$variant(s.history),
+                            yielded: s.yielded,
+                        }
+                    })+
+                }
+            }
+
+            #[inline]
+            fn algorithmic_tangent(
+                &self,
+                trial: &SymSpectral,
+                history: &SceneHistory,
+                state: &LawState<SceneHistory>,
+            ) -> Tensor4 {
+                match self {
+                    $(SceneLaw::$variant(law) => {
+                        let (h, s) = inner_state!($variant, history, state);
+                        law.algorithmic_tangent(trial, &h, &s)
+                    })+
+                }
+            }
+
+            #[inline]
+            fn loading_tangent(
+                &self,
+                trial: &SymSpectral,
+                history: &SceneHistory,
+                state: &LawState<SceneHistory>,
+            ) -> Tensor4 {
+                match self {
+                    $(SceneLaw::$variant(law) => {
+                        let (h, s) = inner_state!($variant, history, state);
+                        law.loading_tangent(trial, &h, &s)
+                    })+
+                }
+            }
+
+            fn elasticity(&self) -> Option<IsotropicElasticity> {
+                match self {
+                    $(SceneLaw::$variant(law) => LogStrainLaw::elasticity(law),)+
+                }
+            }
+
+            #[inline]
+            fn point_shear_modulus(&self, history: &SceneHistory) -> Option<f64> {
+                match self {
+                    $(SceneLaw::$variant(law) => {
+                        #[allow(unreachable_patterns)]
+                        let h = match history {
+                            SceneHistory::$variant(h) => *h,
+                            _ => Default::default(),
+                        };
+                        law.point_shear_modulus(&h)
+                    })+
+                }
+            }
+
+            fn stored_energy(&self, elastic_strain: &Vector3<f64>, history: &SceneHistory) -> Option<f64> {
+                match self {
+                    $(SceneLaw::$variant(law) => {
+                        #[allow(unreachable_patterns)]
+                        let h = match history {
+                            SceneHistory::$variant(h) => *h,
+                            _ => Default::default(),
+                        };
+                        law.stored_energy(elastic_strain, &h)
+                    })+
+                }
             }
         }
     };
+    (@first $first:expr $(, $rest:expr)*) => { $first };
+}
+
+/// The history and state of law variant `$variant` inside a
+/// [`SceneHistory`] and its `LawState` (another variant reads as the
+/// default history).
+macro_rules! inner_state {
+    ($variant:ident, $history:expr, $state:expr) => {{
+        #[allow(unreachable_patterns)]
+        let h = match $history {
+            SceneHistory::$variant(h) => *h,
+            _ => Default::default(),
+        };
+        #[allow(unreachable_patterns)]
+        let inner = match $state.history {
+            SceneHistory::$variant(h) => h,
+            _ => Default::default(),
+        };
+        let s = LawState {
+            tau: $state.tau,
+            elastic_strain: $state.elastic_strain,
+            history: inner,
+            yielded: $state.yielded,
+        };
+        (h, s)
+    }};
+}
+
+/// The laws of `params` (material `k` is `params[k]`), each of the model
+/// beside it, as one [`SceneLaws`].
+///
+/// # Errors
+/// As [`SceneLaw::new`], and [`SolverError::Material`] for no material.
+pub fn scene_laws(materials: &[(MaterialModel, MaterialParams)]) -> Result<SceneLaws, SolverError> {
+    let laws = materials
+        .iter()
+        .map(|(model, params)| SceneLaw::new(*model, params))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(MaterialSet::new(laws)?)
 }
 
 /// The yield stress of a plastic model, or an error naming the model.
@@ -135,11 +295,11 @@ fn yield_stress(p: &MaterialParams, model: &str) -> Result<f64, SolverError> {
 
 register_laws! {
     /// Hencky elasticity (Coombs et al. 2020 §2).
-    Hencky => "hencky", |p| HenckyElastic::new(p.youngs_modulus, p.poisson_ratio);
+    Hencky => "hencky", HenckyElastic, |p| HenckyElastic::new(p.youngs_modulus, p.poisson_ratio);
     /// Compressible Neo-Hookean elasticity (Bonet & Wood eq. 6.27).
-    NeoHookean => "neo_hookean", |p| NeoHookean::new(p.youngs_modulus, p.poisson_ratio);
+    NeoHookean => "neo_hookean", NeoHookean, |p| NeoHookean::new(p.youngs_modulus, p.poisson_ratio);
     /// Von Mises elasto-plasticity with linear hardening (eq. 16).
-    VonMises => "von_mises", |p| VonMises::new(
+    VonMises => "von_mises", VonMises, |p| VonMises::new(
         p.youngs_modulus,
         p.poisson_ratio,
         yield_stress(p, "von_mises")?,
@@ -150,41 +310,120 @@ register_laws! {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Matrix3;
 
-    struct Name;
-
-    impl LawVisitor for Name {
-        type Output = &'static str;
-        fn visit<L: LogStrainLaw>(self, _: L) -> &'static str {
-            std::any::type_name::<L>()
+    fn params(yield_stress: Option<f64>) -> MaterialParams {
+        MaterialParams {
+            youngs_modulus: 1e6,
+            poisson_ratio: 0.3,
+            yield_stress,
+            hardening: 2e4,
         }
     }
 
     #[test]
     fn every_model_builds_and_bad_parameters_are_errors() {
-        let mut p = MaterialParams {
-            youngs_modulus: 1e6,
-            poisson_ratio: 0.3,
-            yield_stress: None,
-            hardening: 0.0,
-        };
-        let hencky = dispatch_law(MaterialModel::Hencky, &p, Name).expect("hencky");
-        assert!(hencky.ends_with("HenckyElastic"), "{hencky}");
-        let e = dispatch_law(MaterialModel::VonMises, &p, Name).expect_err("no yield stress");
-        assert!(e.to_string().contains("needs yield_stress"), "{e}");
+        let mut p = params(None);
+        for model in MaterialModel::ALL {
+            match SceneLaw::new(*model, &p) {
+                Ok(law) => assert_eq!(law.model(), *model),
+                Err(e) => {
+                    assert_eq!(*model, MaterialModel::VonMises);
+                    assert!(e.to_string().contains("needs yield_stress"), "{e}");
+                }
+            }
+        }
         p.yield_stress = Some(1e3);
-        let vm = dispatch_law(MaterialModel::VonMises, &p, Name).expect("von mises");
-        assert!(vm.ends_with("VonMises"), "{vm}");
-        let nh = dispatch_law(MaterialModel::NeoHookean, &p, Name).expect("neo-hookean");
-        assert!(nh.ends_with("NeoHookean"), "{nh}");
+        assert!(SceneLaw::new(MaterialModel::VonMises, &p).is_ok());
         p.poisson_ratio = 0.5;
         assert!(matches!(
-            dispatch_law(MaterialModel::Hencky, &p, Name),
+            SceneLaw::new(MaterialModel::Hencky, &p),
             Err(SolverError::Material(_))
         ));
+        assert!(matches!(scene_laws(&[]), Err(SolverError::Material(_))));
         assert_eq!(
             "von_mises".parse::<MaterialModel>(),
             Ok(MaterialModel::VonMises)
+        );
+    }
+
+    /// A trial log strain with a large shear, so von Mises yields, and
+    /// two equal principal values.
+    fn trials() -> [SymSpectral; 2] {
+        let sheared = Matrix3::new(2e-2, 8e-3, 0.0, 8e-3, -1e-2, 3e-3, 0.0, 3e-3, 4e-3);
+        let repeated = Matrix3::from_diagonal(&Vector3::new(-3e-2, 1e-2, 1e-2));
+        [sheared, repeated].map(|e| SymSpectral::new(&e).expect("spectral"))
+    }
+
+    /// The run-time law's answers are the typed law's, bit for bit, over
+    /// two successive plastic updates (the second reads the first's
+    /// history).
+    fn same_as_typed<L: LogStrainLaw>(
+        typed: &L,
+        any: &SceneLaw,
+        wrap: fn(L::History) -> SceneHistory,
+    ) {
+        for trial in trials() {
+            let (mut h, mut ha) = (L::History::default(), any.initial_history());
+            for _ in 0..2 {
+                let (s, sa) = (typed.return_map(&trial, &h), any.return_map(&trial, &ha));
+                assert_eq!(s.tau, sa.tau);
+                assert_eq!(s.elastic_strain, sa.elastic_strain);
+                assert_eq!(s.yielded, sa.yielded);
+                assert_eq!(wrap(s.history), sa.history);
+                assert_eq!(
+                    typed.algorithmic_tangent(&trial, &h, &s),
+                    any.algorithmic_tangent(&trial, &ha, &sa)
+                );
+                assert_eq!(
+                    typed.loading_tangent(&trial, &h, &s),
+                    any.loading_tangent(&trial, &ha, &sa)
+                );
+                assert_eq!(typed.point_shear_modulus(&h), any.point_shear_modulus(&ha));
+                assert_eq!(
+                    typed.stored_energy(&s.elastic_strain, &s.history),
+                    any.stored_energy(&sa.elastic_strain, &sa.history)
+                );
+                (h, ha) = (s.history, sa.history);
+            }
+        }
+        assert_eq!(typed.elasticity(), any.elasticity());
+    }
+
+    #[test]
+    fn every_law_is_its_typed_law_bit_for_bit() {
+        let p = params(Some(5e3));
+        let hencky = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio).expect("law");
+        let any = SceneLaw::new(MaterialModel::Hencky, &p).expect("law");
+        same_as_typed(&hencky, &any, SceneHistory::Hencky);
+        let nh = NeoHookean::new(p.youngs_modulus, p.poisson_ratio).expect("law");
+        let any = SceneLaw::new(MaterialModel::NeoHookean, &p).expect("law");
+        same_as_typed(&nh, &any, SceneHistory::NeoHookean);
+        let vm = VonMises::new(p.youngs_modulus, p.poisson_ratio, 5e3, p.hardening).expect("law");
+        let any = SceneLaw::new(MaterialModel::VonMises, &p).expect("law");
+        same_as_typed(&vm, &any, SceneHistory::VonMises);
+        // The trial does yield, so the plastic branch was compared.
+        let state = any.return_map(&trials()[0], &any.initial_history());
+        assert!(state.yielded && state.history.equivalent_plastic_strain() > 0.0);
+    }
+
+    #[test]
+    fn histories_survive_their_flat_form_and_a_foreign_index_reads_as_default() {
+        let vm = SceneHistory::VonMises(mpm_constitutive::VonMisesHistory { alpha: 0.25 });
+        for h in [SceneHistory::Hencky(()), SceneHistory::NeoHookean(()), vm] {
+            let mut out = vec![7.0];
+            h.write(&mut out);
+            assert_eq!(out.len(), 1 + SceneHistory::LEN);
+            assert_eq!(SceneHistory::read(&out[1..]), h);
+        }
+        assert_eq!(SceneHistory::read(&[99.0, 1.0]), SceneHistory::default());
+        // A point whose history is another law's starts from the law's
+        // default: the same answer as from its own default history.
+        let law = SceneLaw::new(MaterialModel::VonMises, &params(Some(5e3))).expect("law");
+        let trial = &trials()[0];
+        assert_eq!(
+            law.return_map(trial, &SceneHistory::Hencky(())),
+            law.return_map(trial, &law.initial_history())
         );
     }
 }

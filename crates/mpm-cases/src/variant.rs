@@ -1,13 +1,16 @@
 //! The MPM variant of a run — basis, formulation, locking treatment and
-//! domain update — chosen at run time by name and dispatched to a fully
-//! monomorphised solver.
+//! domain update — chosen at run time by name. The basis and the
+//! formulation, which shape every per-point and per-node loop, are
+//! dispatched to a monomorphised solver ([`dispatch`]); the GIMP domain
+//! rule and volume convention, which act once per point and step, are a
+//! run-time value ([`AnyGimpRule`]), as is the locking treatment (the
+//! scene runner's `Option<FBar>`).
 
 use mpm_basis::{BoundaryBSpline, Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    ConvectedCorners, CornerMidpoint, DetF, DiagF, DomainUpdater, DomainVolume, Flat, Formulation,
-    IncrementalVolumeCorrectedDiagF, Midpoint, NoUpdate, PreviouslyConverged, StretchU,
-    UpdatedLagrangian, VolumeCorrectedDiagF,
+    AnyGimpRule, ConvectedCorners, DomainUpdater, Flat, Formulation, GimpRule, NoUpdate,
+    PreviouslyConverged, UpdatedLagrangian,
 };
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
@@ -138,6 +141,31 @@ named_enum!(
         Cpdi2 => "cpdi2",
     }
 );
+
+impl DomainUpdateKind {
+    /// The GIMP rule of this name.
+    ///
+    /// # Errors
+    /// For `cpdi2`, which convects CPDI2's corners.
+    pub fn gimp_rule(self) -> Result<GimpRule, String> {
+        Ok(match self {
+            Self::None => GimpRule::None,
+            Self::DetF => GimpRule::DetF,
+            Self::DiagF => GimpRule::DiagF,
+            Self::Stretch => GimpRule::Stretch,
+            Self::CornerMidpoint => GimpRule::CornerMidpoint,
+            Self::Midpoint => GimpRule::Midpoint,
+            Self::VolumeCorrectedDiagF => GimpRule::VolumeCorrectedDiagF,
+            Self::IncrementalVolumeCorrectedDiagF => GimpRule::IncrementalVolumeCorrectedDiagF,
+            Self::Cpdi2 => {
+                return Err(
+                    "domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2"
+                        .into(),
+                );
+            }
+        })
+    }
+}
 
 named_enum!(
     /// The integration volume of GIMP points.
@@ -352,53 +380,18 @@ where
     }
 }
 
-/// GIMP with every domain rule of Coombs et al. 2020 §6.4, each optionally
-/// integrating with the domain's volume.
+/// GIMP with every domain rule of Coombs et al. 2020 §6.4 and either
+/// volume convention, chosen at run time ([`AnyGimpRule`]: one solver for
+/// all of them).
 fn gimp<const D: usize, V, B>(variant: &Variant, visitor: V, basis: B) -> Result<V::Output, String>
 where
     V: VariantVisitor<D>,
     B: InitialDomain<D, Mesh = RegularGrid<D>, Domain = SVector<f64, D>>,
     B::Domain: Flat + DomainBounds<D>,
 {
-    // The rules, each wrapped by `$wrap` (the identity, or the domain's
-    // volume as the points' integration volume).
-    macro_rules! rules {
-        ($wrap:expr) => {
-            match variant.domain_update {
-                DomainUpdateKind::None => {
-                    with_formulation(variant, visitor, basis, $wrap(NoUpdate))
-                }
-                DomainUpdateKind::DetF => with_formulation(variant, visitor, basis, $wrap(DetF)),
-                DomainUpdateKind::DiagF => with_formulation(variant, visitor, basis, $wrap(DiagF)),
-                DomainUpdateKind::Stretch => {
-                    with_formulation(variant, visitor, basis, $wrap(StretchU))
-                }
-                DomainUpdateKind::CornerMidpoint => {
-                    with_formulation(variant, visitor, basis, $wrap(CornerMidpoint))
-                }
-                DomainUpdateKind::Midpoint => {
-                    with_formulation(variant, visitor, basis, $wrap(Midpoint))
-                }
-                DomainUpdateKind::VolumeCorrectedDiagF => {
-                    with_formulation(variant, visitor, basis, $wrap(VolumeCorrectedDiagF))
-                }
-                DomainUpdateKind::IncrementalVolumeCorrectedDiagF => with_formulation(
-                    variant,
-                    visitor,
-                    basis,
-                    $wrap(IncrementalVolumeCorrectedDiagF),
-                ),
-                DomainUpdateKind::Cpdi2 => {
-                    return Err(
-                        "domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2"
-                            .into(),
-                    );
-                }
-            }
-        };
-    }
-    Ok(match variant.gimp_volume {
-        GimpVolumeKind::DetF => rules!(std::convert::identity),
-        GimpVolumeKind::Domain => rules!(DomainVolume),
-    })
+    let rule = AnyGimpRule {
+        rule: variant.domain_update.gimp_rule()?,
+        domain_volume: variant.gimp_volume == GimpVolumeKind::Domain,
+    };
+    Ok(with_formulation(variant, visitor, basis, rule))
 }

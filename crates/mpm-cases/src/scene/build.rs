@@ -15,8 +15,7 @@ use nalgebra::SVector;
 use toml::Spanned;
 
 use crate::CasesError;
-use crate::material::{LawVisitor, MaterialModel, MaterialParams, dispatch_law};
-use crate::run::HistoryOutput;
+use crate::material::{MaterialModel, MaterialParams, SceneLaw};
 use crate::scene_file::SceneSource;
 use crate::variant::{BasisKind, DomainUpdateKind, LockingKind, Variant};
 
@@ -510,19 +509,6 @@ fn lookup_ref<'m, V>(
     })
 }
 
-/// Checks that a law can be built from `params`.
-struct Validate;
-
-impl LawVisitor for Validate {
-    type Output = ();
-    fn visit<L>(self, _law: L)
-    where
-        L: mpm_constitutive::LogStrainLaw,
-        L::History: HistoryOutput + mpm_solver::Flat,
-    {
-    }
-}
-
 impl<const D: usize> Problem<D> {
     /// Builds the scene with at least `basis_padding` cells of padding
     /// (and at least what the scene's basis needs, [`SolverSpec::padding`]).
@@ -946,7 +932,7 @@ impl<const D: usize> Problem<D> {
                     ),
                 ));
             }
-            dispatch_law(spec.model, &params, Validate).map_err(|e| {
+            SceneLaw::new(spec.model, &params).map_err(|e| {
                 src.at(
                     &spec.name,
                     format!("material `{}`: {e}", spec.name.get_ref()),

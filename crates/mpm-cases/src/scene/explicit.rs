@@ -8,13 +8,11 @@
 //! The solvers are compiled once per dimension, here ([`RunExplicit`]):
 //! basis (`linear`, `bspline2`, `bspline2_boundary`, `gimp` with its
 //! `domain_update` rule chosen at run time, and `cpdi2` with its convected
-//! corners) × law (closed-form `NeoHookean`, `Spectral<HenckyElastic>`,
-//! `Spectral<VonMises>`, each alone or as a `MaterialSet` when the scene's
-//! materials differ in more than density) × transfer (`FlipPic`, which
-//! covers PIC, FLIP and their blend; `Taylor`) × dilatation (`NoLocking`,
-//! `CellAveraged`): 120 solvers per dimension. A scene of one material (or of materials that
-//! differ in density only) runs the law alone: no tag per point, one wave
-//! modulus; a basis without domains stores none.
+//! corners) × transfer (`FlipPic`, which covers PIC, FLIP and their blend;
+//! `Taylor`) × dilatation (`NoLocking`, `CellAveraged`): 20 solvers per
+//! dimension. The materials are a run-time value ([`ExplicitLaws`]: the
+//! law chosen per point, each point tagged with its material); a basis
+//! without domains stores none.
 //!
 //! ```
 //! use mpm_cases::run::RunControl;
@@ -62,28 +60,24 @@
 use std::time::Instant;
 
 use mpm_basis::{BasisFunction, BoundaryBSpline, Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
-use mpm_constitutive::{
-    HenckyElastic, IncrementalLaw, MaterialSet, MaterialState, NeoHookean, Spectral, Tagged,
-    VonMises,
-};
+use mpm_constitutive::{IncrementalLaw, MaterialSet, MaterialState, Tagged};
 use mpm_mesh::RegularGrid;
 use mpm_solver::explicit::{
     DilatationTreatment, Energies, ExplicitStageTimes, PointsFor, PointsOf, StepInfo,
     VelocityGradient,
 };
 use mpm_solver::{
-    CellAveraged, ConvectedCorners, CornerMidpoint, DetF, DiagF, DisplacementField, DomainContext,
-    DomainError, DomainUpdater, ExplicitOptions, ExplicitPoints, ExplicitSolver, Flat, FlipPic,
-    IncrementalVolumeCorrectedDiagF, Midpoint, NoLocking, NoUpdate, RunState, RunSummary,
-    SolverError, StretchU, Taylor, Transfer, VolumeCorrectedDiagF,
+    AnyGimpRule, CellAveraged, ConvectedCorners, DomainUpdater, ExplicitOptions, ExplicitPoints,
+    ExplicitSolver, Flat, FlipPic, NoLocking, NoUpdate, RunState, RunSummary, SolverError, Taylor,
+    Transfer,
 };
 use nalgebra::{Matrix3, SVector};
 
-use crate::material::MaterialModel;
 use crate::run::{Checkpoint, DomainBounds, HistoryOutput, RunControl, Snapshot};
-use crate::variant::{BasisKind, DomainUpdateKind, LockingKind};
+use crate::variant::{BasisKind, LockingKind};
 
 use super::build::{ExplicitSetup, Problem, SceneMesh};
+use super::explicit_law::{ExplicitLaw, ExplicitLaws};
 use super::format::TransferKind;
 
 /// What an explicit run reports to its observer.
@@ -232,43 +226,12 @@ fn dispatch<const D: usize>(
         BasisKind::Linear => run.with_basis(LinearMpm, NoUpdate),
         BasisKind::BSpline2 => run.with_basis(QuadraticBSpline, NoUpdate),
         BasisKind::BSpline2Boundary => run.with_basis(BoundaryBSpline, NoUpdate),
-        BasisKind::Gimp => run.with_basis(Gimp, GimpRule(problem.variant.domain_update)),
-        BasisKind::Cpdi2 => run.with_basis(Cpdi2, ConvectedCorners),
-    }
-}
-
-/// The GIMP domain rule of the scene, chosen when the run starts (one
-/// solver for every rule rather than one per rule: a branch per point and
-/// step, beside the stress update): every rule of Coombs et al. 2020
-/// §6.4, those that convect mid-points with the grid included; the
-/// builder refuses `cpdi2` with `basis = "gimp"`.
-#[derive(Debug, Clone, Copy)]
-struct GimpRule(DomainUpdateKind);
-
-impl<const D: usize> DomainUpdater<D, SVector<f64, D>> for GimpRule {
-    const NAME: &'static str = "gimp";
-
-    fn update(
-        &self,
-        ctx: &DomainContext<'_, D, SVector<f64, D>>,
-        field: impl DisplacementField<D>,
-    ) -> Result<SVector<f64, D>, DomainError> {
-        match self.0 {
-            DomainUpdateKind::None => NoUpdate.update(ctx, field),
-            DomainUpdateKind::DetF => DetF.update(ctx, field),
-            DomainUpdateKind::DiagF => DiagF.update(ctx, field),
-            DomainUpdateKind::Stretch => StretchU.update(ctx, field),
-            DomainUpdateKind::VolumeCorrectedDiagF => VolumeCorrectedDiagF.update(ctx, field),
-            DomainUpdateKind::IncrementalVolumeCorrectedDiagF => {
-                IncrementalVolumeCorrectedDiagF.update(ctx, field)
-            }
-            DomainUpdateKind::CornerMidpoint => CornerMidpoint.update(ctx, field),
-            DomainUpdateKind::Midpoint => Midpoint.update(ctx, field),
-            other => Err(DomainError::Inadmissible {
-                rule: "gimp",
-                reason: format!("domain_update = {other} applies to basis = cpdi2"),
-            }),
+        BasisKind::Gimp => {
+            let rule =
+                (problem.variant.domain_update.gimp_rule()).map_err(SolverError::InvalidInput)?;
+            run.with_basis(Gimp, AnyGimpRule::new(rule))
         }
+        BasisKind::Cpdi2 => run.with_basis(Cpdi2, ConvectedCorners),
     }
 }
 
@@ -279,60 +242,19 @@ struct Run<'a, 'o, const D: usize> {
 }
 
 impl<const D: usize> Run<'_, '_, D> {
-    /// The law: one, or a [`MaterialSet`] when the materials differ in
-    /// more than their density.
+    /// The laws of the scene's materials, chosen per point
+    /// ([`ExplicitLaws`]).
     fn with_basis<B, R>(self, basis: B, rule: R) -> Result<ExplicitOutput, SolverError>
     where
         B: BasisFunction<D, Mesh = RegularGrid<D>>,
         B::Domain: Flat + DomainBounds<D>,
         R: DomainUpdater<D, B::Domain>,
     {
-        let Some(material) = self.problem.materials.first() else {
-            return Err(SolverError::InvalidInput(
-                "the scene has no material".into(),
-            ));
-        };
-        // Materials that differ in density only share one law (no tag per
-        // point); others make a set, each point tagged with its material.
-        let materials = &self.problem.materials;
-        let one_law = materials.iter().all(|m| m.params == material.params);
-        macro_rules! with_laws {
-            (|$p:ident| $make:expr) => {{
-                if one_law {
-                    let $p = &material.params;
-                    self.with_law(basis, rule, $make)
-                } else {
-                    let laws = materials
-                        .iter()
-                        .map(|m| -> Result<_, SolverError> {
-                            let $p = &m.params;
-                            Ok($make)
-                        })
-                        .collect::<Result<Vec<_>, _>>()?;
-                    self.with_law(basis, rule, MaterialSet::new(laws)?)
-                }
-            }};
-        }
-        match material.model {
-            MaterialModel::NeoHookean => {
-                with_laws!(|p| NeoHookean::new(p.youngs_modulus, p.poisson_ratio)?)
-            }
-            MaterialModel::Hencky => with_laws!(|p| Spectral::new(HenckyElastic::new(
-                p.youngs_modulus,
-                p.poisson_ratio
-            )?)?),
-            MaterialModel::VonMises => with_laws!(|p| {
-                let yield_stress = p.yield_stress.ok_or_else(|| {
-                    SolverError::InvalidInput("material = von_mises needs yield_stress".into())
-                })?;
-                Spectral::new(VonMises::new(
-                    p.youngs_modulus,
-                    p.poisson_ratio,
-                    yield_stress,
-                    p.hardening,
-                )?)?
-            }),
-        }
+        let laws = (self.problem.materials.iter())
+            .map(|m| ExplicitLaw::new(m.model, &m.params))
+            .collect::<Result<Vec<_>, _>>()?;
+        let laws: ExplicitLaws = MaterialSet::new(laws)?;
+        self.with_law(basis, rule, laws)
     }
 
     /// The transfer.

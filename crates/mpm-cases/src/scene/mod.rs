@@ -58,6 +58,7 @@
 
 pub mod build;
 pub mod explicit;
+pub mod explicit_law;
 pub mod format;
 pub mod png;
 mod program;

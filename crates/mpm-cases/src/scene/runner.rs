@@ -1,25 +1,27 @@
-//! Runs a built [`Problem`] with the variant and materials it names: the
-//! variant and the law are dispatched to a fully monomorphised solver (a
-//! scene of one material runs its law directly; several run a
-//! `MaterialSet` whose history carries each point's material).
+//! Runs a built [`Problem`] with the variant and materials it names.
+//!
+//! What runs per point and per node is compiled for each dimension, basis
+//! and formulation; everything else is a value chosen here at run time:
+//! the materials (one [`SceneLaws`], the law chosen per point), the GIMP
+//! domain rule and volume convention (`mpm_solver::AnyGimpRule`) and the
+//! locking treatment (`Option<FBar>`, `Option<FPatch>`, chosen per stage).
 
 use std::sync::Arc;
 
 use mpm_basis::LinearSimplex;
-use mpm_constitutive::LogStrainLaw;
+use mpm_constitutive::Tagged;
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
     BodyForcePath, DomainUpdater, FBar, FPatch, Flat, Formulation, LockingTreatment,
-    MaterialPoints, MovableMesh, NoLocking, NoUpdate, PreviouslyConverged, SolverError, StepReport,
+    MaterialPoints, MovableMesh, NoUpdate, PreviouslyConverged, SolverError, StepReport,
     UpdatedLagrangian,
 };
 use nalgebra::SVector;
 
 use crate::body::InitialDomain;
-use crate::material::{LawVisitor, MaterialTag, dispatch_law, dispatch_law_set};
+use crate::material::{SceneHistory, SceneLaws, scene_laws};
 use crate::run::{
-    Analysis, DomainBounds, HistoryOutput, RunControl, RunOutput, Snapshot, StepObserver,
-    simulate_points,
+    Analysis, DomainBounds, RunControl, RunOutput, Snapshot, StepObserver, simulate_points,
 };
 use crate::variant::{FormulationKind, LockingKind, VariantVisitor, dispatch};
 
@@ -27,8 +29,8 @@ use super::build::{Problem, SceneMesh};
 
 /// Runs `problem`; `observer` sees every converged step.
 ///
-/// The solvers behind a scene (every variant × law × locking treatment)
-/// are compiled once per dimension, in this crate, through
+/// The solvers behind a scene (one per basis and formulation) are
+/// compiled once per dimension, in this crate, through
 /// [`RunScene`]: a caller's closure reaches them as a
 /// [`StepObserver`] trait object, so neither this crate's cases nor a
 /// downstream binary compiles the matrix again.
@@ -82,7 +84,7 @@ macro_rules! run_scene_in {
 
 run_scene_in!(2, 3);
 
-/// [`run`] in dimension `D`: dispatches the variant and the law.
+/// [`run`] in dimension `D`: the scene's laws, then its variant.
 fn run_in<const D: usize>(
     problem: &Problem<D>,
     control: &RunControl,
@@ -93,58 +95,49 @@ fn run_in<const D: usize>(
             "the scene's solver is explicit: run it with scene::run_explicit".into(),
         ));
     }
+    let materials: Vec<_> = (problem.materials.iter())
+        .map(|m| (m.model, m.params))
+        .collect();
+    let laws = scene_laws(&materials)?;
     match &problem.mesh {
         SceneMesh::Grid(grid) => dispatch(
             &problem.variant,
             WithVariant {
                 problem,
                 mesh: grid,
+                laws,
                 control,
                 observer,
             },
         )
         .map_err(SolverError::InvalidInput)?,
         SceneMesh::Simplex(mesh) => {
+            let patches = problem.patch_of_element.as_ref();
             problem
                 .variant
-                .require_simplex("a simplex mesh", problem.patch_of_element.is_some())
+                .require_simplex("a simplex mesh", patches.is_some())
                 .map_err(SolverError::InvalidInput)?;
             let run = WithVariant {
                 problem,
                 mesh: &**mesh,
+                laws,
                 control,
                 observer,
             };
-            let (pc, patches) = (
-                problem.variant.formulation == FormulationKind::Pc,
-                problem.patch_of_element.as_ref(),
-            );
-            match (problem.variant.locking, patches) {
-                (LockingKind::FPatch, Some(map)) => {
-                    let fpatch = FPatch::from_patch_map(map.clone());
-                    if pc {
-                        run.with::<LinearSimplex, PreviouslyConverged, _, _>(
-                            LinearSimplex,
-                            NoUpdate,
-                            fpatch,
-                        )
-                    } else {
-                        run.with::<LinearSimplex, UpdatedLagrangian, _, _>(
-                            LinearSimplex,
-                            NoUpdate,
-                            fpatch,
-                        )
-                    }
-                }
-                _ if pc => run.with::<LinearSimplex, PreviouslyConverged, _, _>(
+            // `require_simplex` lets F-patch through with patches only.
+            let locking = patches
+                .filter(|_| problem.variant.locking == LockingKind::FPatch)
+                .map(|map| FPatch::from_patch_map(map.clone()));
+            match problem.variant.formulation {
+                FormulationKind::Pc => run.with::<LinearSimplex, PreviouslyConverged, _, _>(
                     LinearSimplex,
                     NoUpdate,
-                    NoLocking,
+                    locking,
                 ),
-                _ => run.with::<LinearSimplex, UpdatedLagrangian, _, _>(
+                FormulationKind::Ul => run.with::<LinearSimplex, UpdatedLagrangian, _, _>(
                     LinearSimplex,
                     NoUpdate,
-                    NoLocking,
+                    locking,
                 ),
             }
         }
@@ -154,6 +147,7 @@ fn run_in<const D: usize>(
 struct WithVariant<'a, 'o, const D: usize, M> {
     problem: &'a Problem<D>,
     mesh: &'a M,
+    laws: SceneLaws,
     control: &'a RunControl,
     observer: &'a mut StepObserver<'o, D>,
 }
@@ -167,11 +161,10 @@ impl<const D: usize> VariantVisitor<D> for WithVariant<'_, '_, D, RegularGrid<D>
         F: Formulation,
         U: DomainUpdater<D, B::Domain>,
     {
-        match self.problem.variant.locking {
-            // `dispatch` lets F-bar through with domain_update = none only.
-            LockingKind::FBar => self.with::<B, F, NoUpdate, _>(basis, NoUpdate, FBar::default()),
-            _ => self.with::<B, F, U, _>(basis, updater, NoLocking),
-        }
+        // `dispatch` lets F-bar through with domain_update = none only;
+        // the updater still carries the GIMP volume convention.
+        let locking = (self.problem.variant.locking == LockingKind::FBar).then(FBar::default);
+        self.with::<B, F, U, _>(basis, updater, locking)
     }
 }
 
@@ -180,7 +173,7 @@ where
     M: MovableMesh<D> + Clone,
 {
     /// Runs with basis `B` (on mesh `M`), formulation `F`, updater `U`,
-    /// locking treatment `K` and the scene's materials.
+    /// locking treatment `K` and the scene's laws.
     fn with<B, F, U, K>(self, basis: B, updater: U, locking: K) -> Result<RunOutput<D>, SolverError>
     where
         B: InitialDomain<D, Mesh = M, Domain: Flat + DomainBounds<D>>,
@@ -188,91 +181,65 @@ where
         U: DomainUpdater<D, B::Domain>,
         K: LockingTreatment<D, M>,
     {
-        let materials = &self.problem.materials;
-        let model = materials[0].model;
-        let with_law = WithLaw::<D, M, B, F, U, K> {
-            run: self,
-            basis,
-            updater,
-            locking,
-            formulation: std::marker::PhantomData,
-        };
-        if materials.len() == 1 {
-            dispatch_law(model, &materials[0].params, with_law)?
-        } else {
-            let params: Vec<_> = materials.iter().map(|m| m.params).collect();
-            dispatch_law_set(model, &params, with_law)?
-        }
-    }
-}
-
-struct WithLaw<'a, 'o, const D: usize, M, B, F, U, K> {
-    run: WithVariant<'a, 'o, D, M>,
-    basis: B,
-    updater: U,
-    locking: K,
-    formulation: std::marker::PhantomData<F>,
-}
-
-impl<const D: usize, M, B, F, U, K> LawVisitor for WithLaw<'_, '_, D, M, B, F, U, K>
-where
-    M: MovableMesh<D> + Clone,
-    B: InitialDomain<D, Mesh = M, Domain: Flat + DomainBounds<D>>,
-    F: Formulation,
-    U: DomainUpdater<D, B::Domain>,
-    K: LockingTreatment<D, M>,
-{
-    type Output = Result<RunOutput<D>, SolverError>;
-
-    fn visit<L>(self, law: L) -> Self::Output
-    where
-        L: LogStrainLaw,
-        L::History: HistoryOutput + Flat + MaterialTag,
-    {
-        let p = self.run.problem;
-        let domains = p
-            .position
-            .iter()
-            .zip(&p.half_lengths)
-            .map(|(x, l)| B::initial_domain(x, l))
-            .collect();
-        let mut points: MaterialPoints<D, L::History, B::Domain> =
-            MaterialPoints::new(p.position.clone(), p.volume.clone(), 0.0, domains)?;
-        points.mass.clone_from(&p.mass);
-        if p.materials.len() > 1 {
-            points.history = p
-                .material_of_point
-                .iter()
-                .map(|&m| L::History::for_material(m))
-                .collect();
-        }
-        points.body_force.clone_from(&p.body_force);
-        points.point_force.clone_from(&p.point_forces);
-        if !p.curved.is_empty() || !p.manufactured.is_empty() {
-            let curved = Arc::new(p.curved.clone());
-            let manufactured = p.manufactured.clone();
-            points.body_force_path = Some(BodyForcePath(Arc::new(move |point, lambda| {
-                let f = curved.iter().fold(SVector::<f64, D>::zeros(), |f, c| {
-                    f + c.force[point] * c.curve.at(lambda)
-                });
-                manufactured.iter().fold(f, |f, m| f + (m.0)(point, lambda))
-            })));
-        }
+        let points = initial_points::<D, B>(self.problem, &self.laws)?;
+        let p = self.problem;
         let analysis = Analysis {
-            grid: self.run.mesh.clone(),
-            law,
+            grid: self.mesh.clone(),
+            law: self.laws,
             constraints: p.constraints.clone(),
             stepping: p.stepping,
             newton: p.newton,
         };
-        simulate_points::<D, B, F, U, K, L, _>(
+        simulate_points::<D, B, F, U, K, SceneLaws, _>(
             points,
             analysis,
-            self.basis,
-            self.updater,
-            self.locking,
-            self.run.control,
-            self.run.observer,
+            basis,
+            updater,
+            locking,
+            self.control,
+            self.observer,
         )
     }
+}
+
+/// The scene's material points for basis `B`, each point's history its
+/// material's law's initial history, tagged with the material.
+fn initial_points<const D: usize, B>(
+    p: &Problem<D>,
+    laws: &SceneLaws,
+) -> Result<MaterialPoints<D, Tagged<SceneHistory>, B::Domain>, SolverError>
+where
+    B: InitialDomain<D>,
+{
+    let domains = p
+        .position
+        .iter()
+        .zip(&p.half_lengths)
+        .map(|(x, l)| B::initial_domain(x, l))
+        .collect();
+    let mut points = MaterialPoints::new(p.position.clone(), p.volume.clone(), 0.0, domains)?;
+    points.mass.clone_from(&p.mass);
+    for (k, h) in points.history.iter_mut().enumerate() {
+        let m = p.material_of_point.get(k).copied().unwrap_or(0);
+        let law = laws.laws().get(m as usize).ok_or_else(|| {
+            SolverError::InvalidInput(format!(
+                "point {k} is of material {m}, the scene has {}",
+                laws.laws().len()
+            ))
+        })?;
+        *h = Tagged::new(m, law.initial_history());
+    }
+    points.body_force.clone_from(&p.body_force);
+    points.point_force.clone_from(&p.point_forces);
+    if !p.curved.is_empty() || !p.manufactured.is_empty() {
+        let curved = Arc::new(p.curved.clone());
+        let manufactured = p.manufactured.clone();
+        points.body_force_path = Some(BodyForcePath(Arc::new(move |point, lambda| {
+            let f = curved.iter().fold(SVector::<f64, D>::zeros(), |f, c| {
+                f + c.force[point] * c.curve.at(lambda)
+            });
+            manufactured.iter().fold(f, |f, m| f + (m.0)(point, lambda))
+        })));
+    }
+    Ok(points)
 }
