@@ -1,5 +1,4 @@
-//! The property bodies behind [`crate::law_tangent_properties!`] (feature
-//! `proptest`): one function per property, generic over the law, so that
+//! The property bodies behind [`crate::law_tangent_properties!`]: one function per property, generic over the law, so that
 //! the macro only wires strategies to them and a crate with its own
 //! strategies can call them inside its own `proptest!` block.
 
@@ -8,12 +7,11 @@ use std::fmt::Debug;
 use nalgebra::Matrix3;
 use proptest::test_runner::TestCaseError;
 
-use super::{
-    STEP, TOLERANCE, check_algorithmic_tangent, check_previously_converged, check_spatial,
-    hencky_strain,
+use mpm_constitutive::verification::{
+    self as checks, STEP, TOLERANCE, check_algorithmic_tangent, check_previously_converged,
+    check_spatial, hencky_strain,
 };
-use crate::driver::MaterialState;
-use crate::law::LogStrainLaw;
+use mpm_constitutive::{LogStrainLaw, MaterialState};
 
 /// The law built by `make` from Young's modulus `e` and Poisson's ratio
 /// `nu`; a constructor error fails the test case (the drawn constants are
@@ -33,7 +31,7 @@ pub fn law_from<L, E: Debug>(
 /// Turns the outcome of a check into a test-case outcome: an error fails,
 /// `None` (stencil across the yield surface) rejects, an error above
 /// [`TOLERANCE`] fails.
-fn judge(what: &str, outcome: super::Result<Option<f64>>) -> Result<(), TestCaseError> {
+fn judge(what: &str, outcome: checks::Result<Option<f64>>) -> Result<(), TestCaseError> {
     match outcome {
         Err(err) => Err(TestCaseError::fail(format!("{what}: {err}"))),
         Ok(None) => Err(TestCaseError::reject(
@@ -146,8 +144,8 @@ pub fn algorithmic_tangent_property<L: LogStrainLaw>(
 /// ```
 /// use mpm_constitutive::{HenckyElastic, VonMises};
 ///
-/// mpm_constitutive::law_tangent_properties!(hencky, HenckyElastic::new);
-/// mpm_constitutive::law_tangent_properties!(von_mises, |e, nu| {
+/// mpm_constitutive_proptest::law_tangent_properties!(hencky, HenckyElastic::new);
+/// mpm_constitutive_proptest::law_tangent_properties!(von_mises, |e, nu| {
 ///     VonMises::new(e, nu, 0.5 * e, 0.1 * e)
 /// });
 /// # fn main() {}
@@ -156,17 +154,17 @@ pub fn algorithmic_tangent_property<L: LogStrainLaw>(
 /// functions are expanded but compiled out; the crate's own
 /// `tests/tangents.rs` runs the same two invocations.)
 ///
-/// [`LogStrainLaw`]: crate::LogStrainLaw
-/// [`strategies::config`]: crate::verification::strategies::config
-/// [`strategies::CASES`]: crate::verification::strategies::CASES
-/// [`strategies::deformation_gradient`]: crate::verification::strategies::deformation_gradient
-/// [`strategies::converged_state`]: crate::verification::strategies::converged_state
-/// [`strategies::poisson_ratio`]: crate::verification::strategies::poisson_ratio
-/// [`TOLERANCE`]: crate::verification::TOLERANCE
-/// [`STEP`]: crate::verification::STEP
-/// [`previously_converged_property`]: crate::verification::previously_converged_property
-/// [`spatial_property`]: crate::verification::spatial_property
-/// [`algorithmic_tangent_property`]: crate::verification::algorithmic_tangent_property
+/// [`LogStrainLaw`]: mpm_constitutive::LogStrainLaw
+/// [`strategies::config`]: crate::strategies::config
+/// [`strategies::CASES`]: crate::strategies::CASES
+/// [`strategies::deformation_gradient`]: crate::strategies::deformation_gradient
+/// [`strategies::converged_state`]: crate::strategies::converged_state
+/// [`strategies::poisson_ratio`]: crate::strategies::poisson_ratio
+/// [`TOLERANCE`]: mpm_constitutive::verification::TOLERANCE
+/// [`STEP`]: mpm_constitutive::verification::STEP
+/// [`previously_converged_property`]: crate::previously_converged_property
+/// [`spatial_property`]: crate::spatial_property
+/// [`algorithmic_tangent_property`]: crate::algorithmic_tangent_property
 #[macro_export]
 macro_rules! law_tangent_properties {
     ($name:ident, $constructor:expr $(,)?) => {
@@ -174,39 +172,39 @@ macro_rules! law_tangent_properties {
             #[allow(unused_imports)]
             use super::*;
 
-            $crate::verification::proptest::proptest! {
-                #![proptest_config($crate::verification::strategies::config())]
+            $crate::proptest::proptest! {
+                #![proptest_config($crate::strategies::config())]
 
                 #[test]
                 fn previously_converged_tangent_matches_finite_differences(
-                    delta_f in $crate::verification::strategies::deformation_gradient(0.2, 5.0),
-                    (f_n, be_n) in $crate::verification::strategies::converged_state(),
+                    delta_f in $crate::strategies::deformation_gradient(0.2, 5.0),
+                    (f_n, be_n) in $crate::strategies::converged_state(),
                     e in 1e3f64..1e7,
-                    nu in $crate::verification::strategies::poisson_ratio(),
+                    nu in $crate::strategies::poisson_ratio(),
                 ) {
-                    let law = $crate::verification::law_from($constructor, e, nu)?;
-                    $crate::verification::previously_converged_property(&law, &delta_f, &f_n, &be_n)?;
+                    let law = $crate::law_from($constructor, e, nu)?;
+                    $crate::previously_converged_property(&law, &delta_f, &f_n, &be_n)?;
                 }
 
                 #[test]
                 fn spatial_tangent_matches_finite_differences(
-                    delta_f in $crate::verification::strategies::deformation_gradient(0.2, 5.0),
-                    (f_n, be_n) in $crate::verification::strategies::converged_state(),
+                    delta_f in $crate::strategies::deformation_gradient(0.2, 5.0),
+                    (f_n, be_n) in $crate::strategies::converged_state(),
                     e in 1e3f64..1e7,
-                    nu in $crate::verification::strategies::poisson_ratio(),
+                    nu in $crate::strategies::poisson_ratio(),
                 ) {
-                    let law = $crate::verification::law_from($constructor, e, nu)?;
-                    $crate::verification::spatial_property(&law, &delta_f, &f_n, &be_n)?;
+                    let law = $crate::law_from($constructor, e, nu)?;
+                    $crate::spatial_property(&law, &delta_f, &f_n, &be_n)?;
                 }
 
                 #[test]
                 fn algorithmic_tangent_matches_finite_differences(
-                    strain_f in $crate::verification::strategies::deformation_gradient(0.2, 5.0),
+                    strain_f in $crate::strategies::deformation_gradient(0.2, 5.0),
                     e in 1e3f64..1e7,
-                    nu in $crate::verification::strategies::poisson_ratio(),
+                    nu in $crate::strategies::poisson_ratio(),
                 ) {
-                    let law = $crate::verification::law_from($constructor, e, nu)?;
-                    $crate::verification::algorithmic_tangent_property(&law, &strain_f)?;
+                    let law = $crate::law_from($constructor, e, nu)?;
+                    $crate::algorithmic_tangent_property(&law, &strain_f)?;
                 }
             }
         }

@@ -1,5 +1,5 @@
 //! Proptest strategies for the property tests of constitutive laws
-//! (feature `proptest`): large rotations, stretches with repeated and nearly
+//! : large rotations, stretches with repeated and nearly
 //! repeated eigenvalues, deformation gradients built from them, Poisson
 //! ratios up to the nearly incompressible limit, and converged states.
 

@@ -19,9 +19,9 @@
 //!   and the tangents [`SpatialTangent`] ($a_{ijkl}$, eq. A.1) and
 //!   [`PreviouslyConvergedTangent`] ($\tilde A_{ijkl}$, eqs. A.3–A.6).
 //! - [`verification`]: finite-difference checks of those tangents for any
-//!   [`LogStrainLaw`]; with the feature `proptest`, the strategies and the
-//!   `law_tangent_properties!` macro that turn them into property tests
-//!   of a downstream law.
+//!   [`LogStrainLaw`]; the crate `mpm-constitutive-proptest` holds the
+//!   strategies and the `law_tangent_properties!` macro that turn them
+//!   into property tests of a downstream law.
 //!
 //! Models always work in 3D; a plane-strain problem embeds its $2\times2$
 //! deformation gradient with [`tensor::embed`] ($F_{33} = 1$) and reads its

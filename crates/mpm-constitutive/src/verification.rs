@@ -46,10 +46,10 @@
 //! # Ok::<(), verification::VerificationError>(())
 //! ```
 //!
-//! With the feature `proptest`, `verification::strategies` holds the
-//! random inputs of the crate's property tests, and the macro
-//! `law_tangent_properties!` turns these checks into property tests for
-//! any law (its documentation shows a downstream crate's use).
+//! The crate `mpm-constitutive-proptest` holds the random inputs of the
+//! property tests and the macro `law_tangent_properties!`, which turns
+//! these checks into property tests for any law (its documentation shows a
+//! downstream crate's use).
 
 use std::convert::Infallible;
 
@@ -64,20 +64,6 @@ use crate::error::ConstitutiveError;
 use crate::law::LogStrainLaw;
 use crate::spectral::SymSpectral;
 use crate::tensor::{Tensor4, idx, relative_difference};
-
-#[cfg(feature = "proptest")]
-mod properties;
-#[cfg(feature = "proptest")]
-pub mod strategies;
-
-#[cfg(feature = "proptest")]
-pub use properties::{
-    algorithmic_tangent_property, law_from, previously_converged_property, spatial_property,
-};
-/// The `proptest` crate, re-exported so that [`crate::law_tangent_properties!`]
-/// expands in a crate that does not depend on it directly.
-#[cfg(feature = "proptest")]
-pub use proptest;
 
 /// Required agreement of an analytic tangent and its finite difference, in
 /// [`relative_error`]: the tolerance of the crate's tests and of

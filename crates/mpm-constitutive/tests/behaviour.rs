@@ -3,12 +3,12 @@
 
 use approx::assert_relative_eq;
 use mpm_constitutive::tensor::embed;
-use mpm_constitutive::verification::strategies::{
-    config, deformation_gradient, poisson_ratio, rotation,
-};
 use mpm_constitutive::{
     ConsistentTangent, ConstitutiveError, HenckyElastic, MaterialState, PreviouslyConvergedTangent,
     SpatialTangent, SymSpectral, VonMises, VonMisesHistory, update,
+};
+use mpm_constitutive_proptest::strategies::{
+    config, deformation_gradient, poisson_ratio, rotation,
 };
 use nalgebra::{Matrix2, Matrix3, Vector3};
 use proptest::prelude::*;

@@ -5,11 +5,11 @@
 //! materials answering as each of its laws.
 #![allow(clippy::unwrap_used)]
 
-use mpm_constitutive::verification::strategies::{config, deformation_gradient, rotation};
 use mpm_constitutive::{
     ConstitutiveError, HenckyElastic, IncrementalLaw, MaterialSet, MaterialState, NeoHookean,
     Spectral, Tagged, VonMises,
 };
+use mpm_constitutive_proptest::strategies::{config, deformation_gradient, rotation};
 use nalgebra::Matrix3;
 use proptest::prelude::*;
 

@@ -6,9 +6,6 @@
 #![allow(clippy::unwrap_used)]
 
 use mpm_constitutive::tensor::Tensor4;
-use mpm_constitutive::verification::strategies::{
-    config, converged_state, deformation_gradient, poisson_ratio, rotation,
-};
 use mpm_constitutive::verification::{
     SpatialErrors, TOLERANCE, check_algorithmic_tangent, check_previously_converged, check_spatial,
     hencky_strain, jacobian, plastic_scale, relative_error, sym_unit,
@@ -16,6 +13,9 @@ use mpm_constitutive::verification::{
 use mpm_constitutive::{
     ConsistentTangent, HenckyElastic, LogStrainLaw, MaterialState, PreviouslyConvergedTangent,
     SymSpectral, VonMises, VonMisesHistory, update,
+};
+use mpm_constitutive_proptest::strategies::{
+    config, converged_state, deformation_gradient, poisson_ratio, rotation,
 };
 use nalgebra::Matrix3;
 use proptest::prelude::*;
@@ -33,7 +33,7 @@ const STEP: f64 = 1e-4;
 fn exported_tolerance_and_step_are_the_tests_own() {
     assert_eq!(TOLERANCE, TOL);
     assert_eq!(mpm_constitutive::verification::STEP, STEP);
-    assert_eq!(mpm_constitutive::verification::strategies::CASES, 256);
+    assert_eq!(mpm_constitutive_proptest::strategies::CASES, 256);
 }
 
 /// A von Mises model whose yield stress is a random fraction of the trial
@@ -68,9 +68,12 @@ fn von_mises_for(
 // The macro a downstream law uses, instantiated for the crate's two laws:
 // the yield stress E/2 gives elastic and yielding steps over the drawn
 // stretches 0.2–5.
-mpm_constitutive::law_tangent_properties!(hencky_macro, HenckyElastic::new);
-mpm_constitutive::law_tangent_properties!(neo_hookean_macro, mpm_constitutive::NeoHookean::new);
-mpm_constitutive::law_tangent_properties!(von_mises_macro, |e, nu| {
+mpm_constitutive_proptest::law_tangent_properties!(hencky_macro, HenckyElastic::new);
+mpm_constitutive_proptest::law_tangent_properties!(
+    neo_hookean_macro,
+    mpm_constitutive::NeoHookean::new
+);
+mpm_constitutive_proptest::law_tangent_properties!(von_mises_macro, |e, nu| {
     VonMises::new(e, nu, 0.5 * e, 0.1 * e)
 });
 
@@ -220,7 +223,7 @@ fn rotate_first_and_third(a: &Tensor4, q: &Matrix3<f64>) -> Tensor4 {
 
 // A material set answers with the law of the point's tag (the default
 // history: material 0), so its tangents pass the same checks.
-mpm_constitutive::law_tangent_properties!(material_set_macro, |e, nu| {
+mpm_constitutive_proptest::law_tangent_properties!(material_set_macro, |e, nu| {
     mpm_constitutive::MaterialSet::new(vec![
         mpm_constitutive::VonMises::new(e, nu, 1e-3 * e, 0.1 * e)?,
         mpm_constitutive::VonMises::new(10.0 * e, nu, e, 0.0)?,

@@ -3,6 +3,6 @@
 
 use mpm_example_compose::StiffeningHencky;
 
-mpm_constitutive::law_tangent_properties!(stiffening_hencky, |e, nu| StiffeningHencky::new(
-    e, nu, 50.0
-));
+mpm_constitutive_proptest::law_tangent_properties!(stiffening_hencky, |e, nu| {
+    StiffeningHencky::new(e, nu, 50.0)
+});
