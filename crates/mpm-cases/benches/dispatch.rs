@@ -1,0 +1,288 @@
+//! What the scene path's run-time choices cost: one Newton iteration's
+//! assembly (ΔF, the constitutive update with tangents, the internal
+//! force and the stiffness: `ImplicitSolver::assemble_at`) on the same
+//! points and increment, timed two ways side by side:
+//!
+//! - **typed**: every component a type, as a downstream crate composes
+//!   it with `ImplicitBuilder` (the law `HenckyElastic` or `VonMises`, no
+//!   locking treatment `NoLocking`, the GIMP rule `StretchU`);
+//! - **scene**: the solver the scene runner compiles, with the cold axes
+//!   chosen at run time (the laws as `SceneLaws`, a `MaterialSet` of the
+//!   registered-law enum with each point tagged; the locking treatment as
+//!   `Option<FBar>` set to `None`; the GIMP rule as `AnyGimpRule`).
+//!
+//! Cases: 2D and 3D, standard MPM and GIMP, Hencky and von Mises (yield
+//! stress low enough that the base yields), on 1 and 2 threads. The set-up
+//! checks that both paths give the same normalised residual bit for bit,
+//! so the time difference is the dispatch's alone.
+//!
+//! Run: `cargo bench -p mpm-cases --bench dispatch`; numbers are recorded
+//! in `docs/src/benchmarks/dispatch.md`.
+#![allow(missing_docs, clippy::unwrap_used)]
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use mpm_basis::{Gimp, LinearMpm};
+use mpm_cases::body::InitialDomain;
+use mpm_cases::material::{SceneLaws, scene_laws};
+use mpm_cases::scene::{self, Problem};
+use mpm_constitutive::{HenckyElastic, LogStrainLaw, Tagged, VonMises};
+use mpm_mesh::RegularGrid;
+use mpm_solver::{
+    AnyGimpRule, DomainUpdater, FBar, GimpRule, ImplicitSolver, MaterialPoints, NoLocking,
+    NoUpdate, Parts, PreviouslyConverged, StretchU,
+};
+
+/// A block under gravity on a regular grid, base fixed, sides on rollers.
+fn scene_text(dim: usize, basis: &str, model: &str) -> String {
+    let (origin, size, cells, upper) = if dim == 2 {
+        ("[0.0, 0.0]", "[1.0, 1.0]", "[32, 32]", "[1.0, 0.75]")
+    } else {
+        (
+            "[0.0, 0.0, 0.0]",
+            "[1.0, 1.0, 1.0]",
+            "[10, 10, 10]",
+            "[1.0, 1.0, 0.7]",
+        )
+    };
+    let lower = if dim == 2 {
+        "[0.0, 0.0]"
+    } else {
+        "[0.0, 0.0, 0.0]"
+    };
+    let g = if dim == 2 {
+        "[0.0, -10.0]"
+    } else {
+        "[0.0, 0.0, -10.0]"
+    };
+    let base = if dim == 2 { "y_min" } else { "z_min" };
+    let yield_stress = if model == "von_mises" {
+        "yield_stress = 4e3\nhardening = 1e4\n"
+    } else {
+        ""
+    };
+    let rule = if basis == "gimp" { "stretch" } else { "none" };
+    format!(
+        r#"
+[mesh]
+origin = {origin}
+size = {size}
+cells = {cells}
+
+[[material]]
+name = "soil"
+model = "{model}"
+youngs_modulus = 1e6
+poisson_ratio = 0.3
+density = 2000.0
+{yield_stress}
+[[body]]
+name = "block"
+material = "soil"
+region = {{ box = {{ lower = {lower}, upper = {upper} }} }}
+points_per_cell = 2
+
+[[boundary]]
+set = "{base}"
+kind = "fixed"
+
+[[boundary]]
+set = "x_min"
+kind = "roller"
+
+[[boundary]]
+set = "x_max"
+kind = "roller"
+
+[[load]]
+kind = "gravity"
+acceleration = {g}
+
+[solver]
+basis = "{basis}"
+domain_update = "{rule}"
+steps = 1
+"#
+    )
+}
+
+fn problem<const D: usize>(basis: &str, model: &str) -> Problem<D> {
+    let text = scene_text(D, basis, model);
+    let (scene, src) = scene::parse(&text, "dispatch.toml", &[]).unwrap();
+    Problem::<D>::build(&scene, &src, scene.solver.padding()).unwrap()
+}
+
+/// The problem's points with histories `history(point)`.
+fn points<const D: usize, B: InitialDomain<D>, H: Copy + Default>(
+    p: &Problem<D>,
+    history: impl Fn(usize) -> H,
+) -> MaterialPoints<D, H, B::Domain> {
+    let domains = (p.position.iter().zip(&p.half_lengths))
+        .map(|(x, l)| B::initial_domain(x, l))
+        .collect();
+    let mut points =
+        MaterialPoints::new(p.position.clone(), p.volume.clone(), 0.0, domains).unwrap();
+    points.mass.clone_from(&p.mass);
+    points.body_force.clone_from(&p.body_force);
+    points.point_force.clone_from(&p.point_forces);
+    for (k, h) in points.history.iter_mut().enumerate() {
+        *h = history(k);
+    }
+    points
+}
+
+/// A deterministic increment of the free dofs, large enough (1 % strain
+/// at the grid spacing) that von Mises yields at the base.
+fn increment(n: usize, h: f64) -> Vec<f64> {
+    (0..n)
+        .map(|k| 1e-2 * h * ((k * 31 + 7) as f64).sin())
+        .collect()
+}
+
+/// Times both paths on `problem`: the typed law `law`, the typed updater
+/// `typed` and the scene's `any` updater.
+#[allow(clippy::too_many_arguments)]
+fn compare<const D: usize, B, L, U, V>(
+    c: &mut Criterion,
+    name: &str,
+    p: &Problem<D>,
+    basis: B,
+    law: L,
+    typed: U,
+    any: V,
+) where
+    B: InitialDomain<D, Mesh = RegularGrid<D>> + Clone,
+    B::Domain: mpm_solver::Flat,
+    L: LogStrainLaw + Clone,
+    U: DomainUpdater<D, B::Domain>,
+    V: DomainUpdater<D, B::Domain>,
+{
+    let grid = match &p.mesh {
+        scene::build::SceneMesh::Grid(g) => g.clone(),
+        scene::build::SceneMesh::Simplex(_) => unreachable!("grid scenes only"),
+    };
+    let laws: SceneLaws = scene_laws(&[(p.materials[0].model, p.materials[0].params)]).unwrap();
+    let scene_points = points::<D, B, _>(p, |_| Tagged::new(0, laws.laws()[0].initial_history()));
+    let typed_points = points::<D, B, L::History>(p, |_| Default::default());
+    let mut scene_solver: ImplicitSolver<
+        D,
+        Parts<B, PreviouslyConverged, SceneLaws, Option<FBar>, V, _>,
+    > = ImplicitSolver::new(
+        basis.clone(),
+        grid.clone(),
+        laws,
+        None,
+        any,
+        p.constraints.clone(),
+        p.newton,
+    );
+    let mut typed_solver: ImplicitSolver<D, Parts<B, PreviouslyConverged, L, NoLocking, U, _>> =
+        ImplicitSolver::new(
+            basis,
+            grid.clone(),
+            law,
+            NoLocking,
+            typed,
+            p.constraints.clone(),
+            p.newton,
+        );
+    let n = scene_solver.prepare_step(&scene_points, 0.0, 1.0).unwrap();
+    assert_eq!(
+        typed_solver.prepare_step(&typed_points, 0.0, 1.0).unwrap(),
+        n
+    );
+    let du = increment(n, grid.spacing()[0]);
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let (rs, rt) = pool.install(|| {
+            (
+                scene_solver.assemble_at(&scene_points, &du).unwrap(),
+                typed_solver.assemble_at(&typed_points, &du).unwrap(),
+            )
+        });
+        assert_eq!(rs.to_bits(), rt.to_bits(), "{name}: {rs} against {rt}");
+        let mut group = c.benchmark_group(format!("dispatch/{name}/{threads}t"));
+        group
+            .sample_size(20)
+            .warm_up_time(Duration::from_secs(1))
+            .measurement_time(Duration::from_secs(4));
+        let points_label = p.position.len();
+        group.bench_function(BenchmarkId::new("typed", points_label), |b| {
+            b.iter(|| {
+                pool.install(|| black_box(typed_solver.assemble_at(&typed_points, &du).unwrap()))
+            })
+        });
+        group.bench_function(BenchmarkId::new("scene", points_label), |b| {
+            b.iter(|| {
+                pool.install(|| black_box(scene_solver.assemble_at(&scene_points, &du).unwrap()))
+            })
+        });
+        group.finish();
+    }
+}
+
+fn laws() -> (HenckyElastic, VonMises) {
+    (
+        HenckyElastic::new(1e6, 0.3).unwrap(),
+        VonMises::new(1e6, 0.3, 4e3, 1e4).unwrap(),
+    )
+}
+
+fn in_dimension<const D: usize>(c: &mut Criterion) {
+    let (hencky, von_mises) = laws();
+    let d = D;
+    let p = problem::<D>("linear", "hencky");
+    compare(
+        c,
+        &format!("{d}d_linear_hencky"),
+        &p,
+        LinearMpm,
+        hencky,
+        NoUpdate,
+        NoUpdate,
+    );
+    let p = problem::<D>("linear", "von_mises");
+    compare(
+        c,
+        &format!("{d}d_linear_von_mises"),
+        &p,
+        LinearMpm,
+        von_mises,
+        NoUpdate,
+        NoUpdate,
+    );
+    let stretch = AnyGimpRule::new(GimpRule::Stretch);
+    let p = problem::<D>("gimp", "hencky");
+    compare(
+        c,
+        &format!("{d}d_gimp_hencky"),
+        &p,
+        Gimp,
+        hencky,
+        StretchU,
+        stretch,
+    );
+    let p = problem::<D>("gimp", "von_mises");
+    compare(
+        c,
+        &format!("{d}d_gimp_von_mises"),
+        &p,
+        Gimp,
+        von_mises,
+        StretchU,
+        stretch,
+    );
+}
+
+fn dispatch(c: &mut Criterion) {
+    in_dimension::<2>(c);
+    in_dimension::<3>(c);
+}
+
+criterion_group!(benches, dispatch);
+criterion_main!(benches);
