@@ -79,11 +79,14 @@ impl<const D: usize, P: SolverParts<D>> PointPass<'_, D, P> {
     ) -> Option<StepFailure> {
         // The motion's ΔF (eq. 7), or the patch-averaged ΔF̄ the law sees
         // under a coupled treatment (Wang et al. eq. 9).
-        let delta_f = if self.coupled {
-            self.patches.modified(p, &self.increments[p])
-        } else {
-            grid_to_point::deformation_increment(self.sys, self.du, p)
-        };
+        // The constant folds the branch away for a typed treatment that
+        // never couples (`NoLocking`); a run-time choice reads the flag.
+        let delta_f =
+            if <P::Locking as LockingTreatment<D, P::Mesh>>::COUPLES_POINTS && self.coupled {
+                self.patches.modified(p, &self.increments[p])
+            } else {
+                grid_to_point::deformation_increment(self.sys, self.du, p)
+            };
         let state = MaterialState {
             be: self.points.be[p],
             history: self.points.history[p],
