@@ -284,5 +284,115 @@ fn dispatch(c: &mut Criterion) {
     in_dimension::<3>(c);
 }
 
-criterion_group!(benches, dispatch);
+/// One solver of `where_it_goes` on the problem's points.
+fn timed<const D: usize, L, K>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    label: &str,
+    p: &Problem<D>,
+    law: L,
+    locking: K,
+    history: impl Fn(&L) -> L::History,
+    reference: Option<f64>,
+) -> f64
+where
+    L: LogStrainLaw,
+    K: mpm_solver::LockingTreatment<D, RegularGrid<D>>,
+{
+    let grid = match &p.mesh {
+        scene::build::SceneMesh::Grid(g) => g.clone(),
+        scene::build::SceneMesh::Simplex(_) => unreachable!("grid scenes only"),
+    };
+    let h = history(&law);
+    let points = points::<D, LinearMpm, _>(p, |_| h);
+    let mut solver: ImplicitSolver<D, Parts<LinearMpm, PreviouslyConverged, L, K, NoUpdate, _>> =
+        ImplicitSolver::new(
+            LinearMpm,
+            grid.clone(),
+            law,
+            locking,
+            NoUpdate,
+            p.constraints.clone(),
+            p.newton,
+        );
+    let n = solver.prepare_step(&points, 0.0, 1.0).unwrap();
+    let du = increment(n, grid.spacing()[0]);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let r = pool.install(|| solver.assemble_at(&points, &du).unwrap());
+    if let Some(want) = reference {
+        assert_eq!(r.to_bits(), want.to_bits(), "{label}");
+    }
+    group.bench_function(label, |b| {
+        b.iter(|| pool.install(|| black_box(solver.assemble_at(&points, &du).unwrap())))
+    });
+    r
+}
+
+/// Where the scene path's cost goes, 2D standard MPM with Hencky on one
+/// thread: each run-time choice added alone to the typed solver.
+fn where_it_goes(c: &mut Criterion) {
+    use mpm_cases::material::SceneLaw;
+    use mpm_constitutive::MaterialSet;
+    let p = problem::<2>("linear", "hencky");
+    let hencky = HenckyElastic::new(1e6, 0.3).unwrap();
+    let scene_law = SceneLaw::Hencky(hencky.clone());
+    let mut group = c.benchmark_group("where_it_goes/2d_linear_hencky/1t");
+    group
+        .sample_size(30)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(5));
+    let r = timed(
+        &mut group,
+        "typed",
+        &p,
+        hencky.clone(),
+        NoLocking,
+        |_| (),
+        None,
+    );
+    let fbar: Option<FBar> = None;
+    timed(
+        &mut group,
+        "option_fbar",
+        &p,
+        hencky.clone(),
+        fbar,
+        |_| (),
+        Some(r),
+    );
+    let set = MaterialSet::new(vec![hencky.clone()]).unwrap();
+    timed(
+        &mut group,
+        "material_set",
+        &p,
+        set,
+        NoLocking,
+        |_| Tagged::new(0, ()),
+        Some(r),
+    );
+    timed(
+        &mut group,
+        "scene_law",
+        &p,
+        scene_law.clone(),
+        NoLocking,
+        |l| l.initial_history(),
+        Some(r),
+    );
+    let laws = MaterialSet::new(vec![scene_law]).unwrap();
+    timed(
+        &mut group,
+        "scene",
+        &p,
+        laws,
+        fbar,
+        |l| Tagged::new(0, l.laws()[0].initial_history()),
+        Some(r),
+    );
+    group.finish();
+}
+
+criterion_group!(benches, dispatch, where_it_goes);
 criterion_main!(benches);
