@@ -337,32 +337,16 @@ fn where_it_goes(c: &mut Criterion) {
     use mpm_constitutive::MaterialSet;
     let p = problem::<2>("linear", "hencky");
     let hencky = HenckyElastic::new(1e6, 0.3).unwrap();
-    let scene_law = SceneLaw::Hencky(hencky.clone());
+    let scene_law = SceneLaw::Hencky(hencky);
     let mut group = c.benchmark_group("where_it_goes/2d_linear_hencky/1t");
     group
         .sample_size(30)
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(5));
-    let r = timed(
-        &mut group,
-        "typed",
-        &p,
-        hencky.clone(),
-        NoLocking,
-        |_| (),
-        None,
-    );
+    let r = timed(&mut group, "typed", &p, hencky, NoLocking, |_| (), None);
     let fbar: Option<FBar> = None;
-    timed(
-        &mut group,
-        "option_fbar",
-        &p,
-        hencky.clone(),
-        fbar,
-        |_| (),
-        Some(r),
-    );
-    let set = MaterialSet::new(vec![hencky.clone()]).unwrap();
+    timed(&mut group, "option_fbar", &p, hencky, fbar, |_| (), Some(r));
+    let set = MaterialSet::new(vec![hencky]).unwrap();
     timed(
         &mut group,
         "material_set",
