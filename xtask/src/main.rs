@@ -1,6 +1,6 @@
-//! Developer tasks, run as `cargo xtask <task>` (build in release for
-//! meaningful timings: `cargo xtask` runs the debug profile, so use
-//! `cargo run --release -p xtask -- <task>`).
+//! Developer tasks, run as `cargo xtask <task>` (the alias builds in
+//! release, so the timings on the pages it writes are those of the
+//! command it prints).
 //!
 //! - `reproduce coombs2020 [--full] [--kmax K]`: the reproduction report of
 //!   Coombs et al. (2020) — column convergence per domain-update rule
@@ -32,6 +32,8 @@
 //! - `column-table`: error and solver time of the column for standard MPM
 //!   and GIMP (eq. 34), written to `docs/src/benchmarks/column.md`
 //!   ([`column_table`]).
+//! - `structure [--deny]`: functions over 150 lines and import circles
+//!   between files ([`structure`]).
 //! - `reference-values`: reruns the cases of `mpm-cases` with the settings
 //!   of its tests and writes the committed regression values
 //!   `crates/mpm-cases/tests/reference_values/*.json` (column, cantilever,
@@ -52,6 +54,7 @@ mod reference_values;
 mod report;
 mod scene_run;
 mod stability;
+mod structure;
 mod vane;
 mod wang2021;
 
@@ -107,6 +110,9 @@ tasks:
                 reruns the cases with the settings of the tests and writes the
                 committed regression values crates/mpm-cases/tests/reference_values/
                 (*.json, one per case) that tests/regression.rs compares against
+  structure [--deny]
+                functions over 150 lines and import circles between files in every
+                crate's src/ (tests left out); --deny fails on any
   help          this message";
 
 fn main() -> Result<()> {
@@ -131,6 +137,14 @@ fn main() -> Result<()> {
                 [other, ..] => bail!("unexpected argument `{other}` (expected --quick)"),
             };
             report::run(&docs_dir(), mode)
+        }
+        Some("structure") => {
+            let deny = match &args[1..] {
+                [] => false,
+                [flag] if flag == "--deny" => true,
+                [other, ..] => bail!("unexpected argument `{other}` (expected --deny)"),
+            };
+            structure::run(&workspace_dir(), deny)
         }
         Some("column-table") => {
             no_more_arguments(&args[1..])?;

@@ -133,12 +133,12 @@ pub fn algorithmic_tangent_property<L: LogStrainLaw>(
 /// plastic law should choose its yield stress relative to `e` (e.g.
 /// $\rho_y = E/2$) so that both elastic and yielding steps are drawn.
 ///
-/// A downstream crate enables the feature in its `Cargo.toml`, needing no
+/// A downstream crate adds this crate to its dev-dependencies, needing no
 /// dependency on `proptest` of its own:
 /// ```toml
 /// [dev-dependencies]
 /// # inside this workspace; elsewhere `path = ...` or `version = ...`
-/// mpm-constitutive = { workspace = true, features = ["proptest"] }
+/// mpm-constitutive-proptest.workspace = true
 /// ```
 /// and writes, in a test file such as `tests/tangents.rs`:
 /// ```
