@@ -28,6 +28,7 @@ pub mod cases;
 pub mod checkpoint;
 pub mod error;
 pub mod locking;
+pub mod manufactured;
 pub mod material;
 pub mod output;
 pub mod params;

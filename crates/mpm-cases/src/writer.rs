@@ -144,7 +144,7 @@ pub struct ExplicitSummary<P: Serialize> {
     /// Basis.
     pub basis: crate::variant::BasisKind,
     /// Velocity transfer.
-    pub transfer: crate::scene::format::TransferKind,
+    pub transfer: crate::variant::TransferKind,
     /// Its FLIP fraction α.
     pub alpha: f64,
     /// Dilatation treatment (`none` or `cell_averaged`).

@@ -2415,7 +2415,7 @@ fn manufactured_force<const D: usize>(
             format!("`inner_radius` {inner} and `outer_radius` {outer} need 0 < inner < outer"),
         ));
     }
-    // Coombs et al. 2020 §7.4, eq. (44): see `cases::annulus`.
+    // Coombs et al. 2020 §7.4, eq. (44): see `manufactured::Torsion`.
     let x0: Vec<nalgebra::Vector2<f64>> = position
         .iter()
         .map(|x| nalgebra::Vector2::new(x[0], x[1]))
@@ -2425,7 +2425,7 @@ fn manufactured_force<const D: usize>(
         if !range.contains(&q) {
             return SVector::zeros();
         }
-        let torsion = crate::cases::annulus::Torsion {
+        let torsion = crate::manufactured::Torsion {
             inner_radius: inner,
             outer_radius: outer,
             mu: shear_modulus[q],

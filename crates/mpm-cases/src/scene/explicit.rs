@@ -305,7 +305,8 @@ impl<const D: usize> Run<'_, '_, D> {
         }
     }
 
-    /// Runs with every type chosen.
+    /// Runs with every type chosen: the points, the start (or the resumed
+    /// checkpoint), the steps between outputs, the summary.
     fn with<B, R, L, T, K>(
         self,
         basis: B,
@@ -325,7 +326,6 @@ impl<const D: usize> Run<'_, '_, D> {
         K: DilatationTreatment,
     {
         let (grid, setup) = parts(self.problem)?;
-        let problem = self.problem;
         let options = ExplicitOptions {
             time_step: setup.time_step,
             gravity: setup.gravity,
@@ -340,99 +340,28 @@ impl<const D: usize> Run<'_, '_, D> {
             options,
         )?
         .with_domain_update(rule);
-        let points: PointsFor<D, L, T> =
-            ExplicitPoints::new(problem.position.clone(), problem.volume.clone(), 1.0)?;
-        let domains = (problem.position.iter().zip(&problem.half_lengths))
-            .map(|(x, l)| B::initial_domain(x, l))
-            .collect();
-        let mut points: PointsOf<D, B, L, T> = points.with_domains(domains)?;
-        points.mass.clone_from(&problem.mass);
-        points.velocity.clone_from(&setup.velocity);
-        // The constant forces, then those of the loads with a curve, whose
-        // values `scale_timed_forces` sets before every step.
-        points.point_force.clone_from(&setup.point_forces);
-        for timed in &setup.timed_forces {
-            points.point_force.extend_from_slice(&timed.forces);
-        }
-        points.fixed_velocity.clone_from(&setup.point_fixities);
-        for (state, &m) in points.material.iter_mut().zip(&problem.material_of_point) {
-            *state = L::State::for_material(m);
-        }
-        if points.mass.len() != points.len() || points.velocity.len() != points.len() {
-            return Err(SolverError::InvalidInput(format!(
-                "{} points but {} masses and {} velocities",
-                points.len(),
-                points.mass.len(),
-                points.velocity.len()
-            )));
-        }
-        let initial_position = problem.position.clone();
-        let end_time = setup.end_time;
-        let outputs = output_count(end_time, setup.output_interval);
+        let mut points = initial_points::<D, B, L, T>(self.problem, setup)?;
+        let outputs = output_count(setup.end_time, setup.output_interval);
         let output_time = |k: usize| {
             if k >= outputs {
-                end_time
+                setup.end_time
             } else {
                 k as f64 * setup.output_interval
             }
         };
-
-        let observer = self.observer;
         let mut wall = Wall::default();
+        let mut run = Outputs {
+            initial_position: &self.problem.position,
+            control: self.control,
+            observer: self.observer,
+        };
         let mut clock = match &self.control.resume {
             Some(c) => {
-                let clock = Clock::from_checkpoint(c)?;
-                let scene_tags: Vec<u32> =
-                    points.material.iter().map(FlatState::material).collect();
-                points = read_points::<D, L::State, T::PointState, B::Domain>(&c.points, points)?;
-                // A tag past the set's end would index no law: the
-                // checkpoint must be of this scene's materials.
-                if let Some(p) =
-                    (0..points.len()).find(|&p| points.material[p].material() != scene_tags[p])
-                {
-                    return Err(SolverError::InvalidInput(format!(
-                        "the checkpoint gives point {p} material {}, the scene material {}",
-                        points.material[p].material(),
-                        scene_tags[p]
-                    )));
-                }
-                solver.resume_at(
-                    c.state.load_factor,
-                    c.state.summary.steps,
-                    clock.external_work,
-                );
-                wall.earlier = c.wall_time_s;
+                let (resumed, clock) = resume(&mut solver, points, c, &mut wall)?;
+                points = resumed;
                 clock
             }
-            None => {
-                let initial = solver.energies(&points)?;
-                let clock = Clock {
-                    index: 0,
-                    external_work: 0.0,
-                    initial,
-                    scale: initial.kinetic + initial.strain,
-                };
-                let so_far = wall.so_far();
-                wall.observe(|| {
-                    let snapshot = snapshot(
-                        &points,
-                        &initial_position,
-                        0.0,
-                        self.control,
-                        0,
-                        &clock,
-                        so_far,
-                    );
-                    observer(ExplicitEvent::Output(ExplicitFrame {
-                        index: 0,
-                        time: 0.0,
-                        steps: 0,
-                        energies: initial,
-                        snapshot: &snapshot,
-                    }))
-                })?;
-                clock
-            }
+            None => run.start(&solver, &points, &mut wall)?,
         };
         let session_start = *solver.stage_times();
         while clock.index < outputs {
@@ -442,54 +371,224 @@ impl<const D: usize> Run<'_, '_, D> {
             while solver.time() < target * (1.0 - 1e-12) {
                 scale_timed_forces(&mut points.point_force, setup, solver.time());
                 let info = solver.step(&mut points, target - solver.time())?;
-                wall.observe(|| observer(ExplicitEvent::Step(info)))?;
+                wall.observe(|| (run.observer)(ExplicitEvent::Step(info)))?;
             }
-            let energies = solver.energies(&points)?;
-            clock.index += 1;
-            clock.external_work = solver.external_work();
-            clock.scale = clock.scale.max(energies.kinetic + energies.strain);
-            let time = solver.time();
-            let so_far = wall.so_far();
-            wall.observe(|| {
-                let snapshot = snapshot(
-                    &points,
-                    &initial_position,
-                    time,
-                    self.control,
-                    solver.steps(),
-                    &clock,
-                    so_far,
-                );
-                observer(ExplicitEvent::Output(ExplicitFrame {
-                    index: clock.index,
-                    time,
-                    steps: solver.steps(),
-                    energies,
-                    snapshot: &snapshot,
-                }))
-            })?;
+            run.output(&solver, &points, &mut clock, &mut wall)?;
         }
-        let last_energies = solver.energies(&points)?;
-        let scale = clock.scale;
-        let drift = last_energies.total() - clock.initial.total();
+        let mut out = summary(&solver, &points, &clock, &self.problem.position)?;
+        out.outputs = outputs + 1;
+        out.wall_time_s = wall.so_far();
         let stage = solver.stage_times();
-        Ok(ExplicitOutput {
-            last: snapshot_of(&points, &initial_position, solver.time()),
-            steps: solver.steps(),
-            time: solver.time(),
-            outputs: outputs + 1,
-            initial: clock.initial,
-            last_energies,
-            energy_scale: scale,
-            energy_drift: if scale > 0.0 { drift / scale } else { 0.0 },
-            wall_time_s: wall.so_far(),
-            stage_times: ExplicitStageTimes {
-                p2g: stage.p2g - session_start.p2g,
-                grid: stage.grid - session_start.grid,
-                g2p: stage.g2p - session_start.g2p,
-            },
+        out.stage_times = ExplicitStageTimes {
+            p2g: stage.p2g - session_start.p2g,
+            grid: stage.grid - session_start.grid,
+            g2p: stage.g2p - session_start.g2p,
+        };
+        Ok(out)
+    }
+}
+
+/// The scene's points for basis `B`, law `L` and transfer `T`: positions,
+/// volumes, masses, initial velocities, forces (the constant ones, then
+/// those of the loads with a curve, whose values `scale_timed_forces`
+/// sets before every step), fixities and each point's material.
+fn initial_points<const D: usize, B, L, T>(
+    problem: &Problem<D>,
+    setup: &ExplicitSetup<D>,
+) -> Result<PointsOf<D, B, L, T>, SolverError>
+where
+    B: BasisFunction<D>,
+    L: IncrementalLaw,
+    L::State: FlatState,
+    T: Transfer<D>,
+{
+    let points: PointsFor<D, L, T> =
+        ExplicitPoints::new(problem.position.clone(), problem.volume.clone(), 1.0)?;
+    let domains = (problem.position.iter().zip(&problem.half_lengths))
+        .map(|(x, l)| B::initial_domain(x, l))
+        .collect();
+    let mut points: PointsOf<D, B, L, T> = points.with_domains(domains)?;
+    points.mass.clone_from(&problem.mass);
+    points.velocity.clone_from(&setup.velocity);
+    points.point_force.clone_from(&setup.point_forces);
+    for timed in &setup.timed_forces {
+        points.point_force.extend_from_slice(&timed.forces);
+    }
+    points.fixed_velocity.clone_from(&setup.point_fixities);
+    for (state, &m) in points.material.iter_mut().zip(&problem.material_of_point) {
+        *state = L::State::for_material(m);
+    }
+    if points.mass.len() != points.len() || points.velocity.len() != points.len() {
+        return Err(SolverError::InvalidInput(format!(
+            "{} points but {} masses and {} velocities",
+            points.len(),
+            points.mass.len(),
+            points.velocity.len()
+        )));
+    }
+    Ok(points)
+}
+
+/// The points and clock of checkpoint `c`, the solver set to its time.
+fn resume<const D: usize, B, L, T, K, R>(
+    solver: &mut ExplicitSolver<D, B, L, T, K, R>,
+    points: PointsOf<D, B, L, T>,
+    c: &Checkpoint,
+    wall: &mut Wall,
+) -> Result<(PointsOf<D, B, L, T>, Clock), SolverError>
+where
+    B: BasisFunction<D, Mesh = RegularGrid<D>>,
+    B::Domain: Flat,
+    L: IncrementalLaw,
+    L::State: FlatState,
+    T: Transfer<D>,
+    T::PointState: FlatState,
+    K: DilatationTreatment,
+    R: DomainUpdater<D, B::Domain>,
+{
+    let clock = Clock::from_checkpoint(c)?;
+    let scene_tags: Vec<u32> = points.material.iter().map(FlatState::material).collect();
+    let points = read_points::<D, L::State, T::PointState, B::Domain>(&c.points, points)?;
+    // A tag past the set's end would index no law: the checkpoint must be
+    // of this scene's materials.
+    if let Some(p) = (0..points.len()).find(|&p| points.material[p].material() != scene_tags[p]) {
+        return Err(SolverError::InvalidInput(format!(
+            "the checkpoint gives point {p} material {}, the scene material {}",
+            points.material[p].material(),
+            scene_tags[p]
+        )));
+    }
+    solver.resume_at(
+        c.state.load_factor,
+        c.state.summary.steps,
+        clock.external_work,
+    );
+    wall.earlier = c.wall_time_s;
+    Ok((points, clock))
+}
+
+/// What the outputs of a run need: the initial positions (displacements),
+/// whether to keep checkpoints, and the caller's observer.
+struct Outputs<'a, 'o, const D: usize> {
+    initial_position: &'a [SVector<f64, D>],
+    control: &'a RunControl,
+    observer: &'a mut ExplicitObserver<'o>,
+}
+
+impl<const D: usize> Outputs<'_, '_, D> {
+    /// Output 0, the initial state, and the clock that starts from it.
+    fn start<B, L, T, K, R>(
+        &mut self,
+        solver: &ExplicitSolver<D, B, L, T, K, R>,
+        points: &PointsOf<D, B, L, T>,
+        wall: &mut Wall,
+    ) -> Result<Clock, SolverError>
+    where
+        B: BasisFunction<D, Mesh = RegularGrid<D>>,
+        B::Domain: Flat + DomainBounds<D>,
+        L: IncrementalLaw,
+        L::State: FlatState,
+        T: Transfer<D>,
+        T::PointState: FlatState,
+        K: DilatationTreatment,
+        R: DomainUpdater<D, B::Domain>,
+    {
+        let initial = solver.energies(points)?;
+        let clock = Clock {
+            index: 0,
+            external_work: 0.0,
+            initial,
+            scale: initial.kinetic + initial.strain,
+        };
+        self.frame(points, 0.0, 0, initial, &clock, wall)?;
+        Ok(clock)
+    }
+
+    /// The next output: the clock advanced to it, the observer shown it.
+    fn output<B, L, T, K, R>(
+        &mut self,
+        solver: &ExplicitSolver<D, B, L, T, K, R>,
+        points: &PointsOf<D, B, L, T>,
+        clock: &mut Clock,
+        wall: &mut Wall,
+    ) -> Result<(), SolverError>
+    where
+        B: BasisFunction<D, Mesh = RegularGrid<D>>,
+        B::Domain: Flat + DomainBounds<D>,
+        L: IncrementalLaw,
+        L::State: FlatState,
+        T: Transfer<D>,
+        T::PointState: FlatState,
+        K: DilatationTreatment,
+        R: DomainUpdater<D, B::Domain>,
+    {
+        let energies = solver.energies(points)?;
+        clock.index += 1;
+        clock.external_work = solver.external_work();
+        clock.scale = clock.scale.max(energies.kinetic + energies.strain);
+        self.frame(points, solver.time(), solver.steps(), energies, clock, wall)
+    }
+
+    /// Shows the observer output `clock.index` (its time excluded from the
+    /// solver's wall time).
+    fn frame<S: FlatState, T: FlatState, Dom: Flat + DomainBounds<D>>(
+        &mut self,
+        points: &ExplicitPoints<D, S, T, Dom>,
+        time: f64,
+        steps: usize,
+        energies: Energies,
+        clock: &Clock,
+        wall: &mut Wall,
+    ) -> Result<(), SolverError> {
+        let so_far = wall.so_far();
+        let (initial, control) = (self.initial_position, self.control);
+        let observer = &mut *self.observer;
+        wall.observe(|| {
+            let snapshot = snapshot(points, initial, time, control, steps, clock, so_far);
+            observer(ExplicitEvent::Output(ExplicitFrame {
+                index: clock.index,
+                time,
+                steps,
+                energies,
+                snapshot: &snapshot,
+            }))
         })
     }
+}
+
+/// The run's final state and energies (the caller adds the counts and
+/// times of this session).
+fn summary<const D: usize, B, L, T, K, R>(
+    solver: &ExplicitSolver<D, B, L, T, K, R>,
+    points: &PointsOf<D, B, L, T>,
+    clock: &Clock,
+    initial_position: &[SVector<f64, D>],
+) -> Result<ExplicitOutput, SolverError>
+where
+    B: BasisFunction<D, Mesh = RegularGrid<D>>,
+    B::Domain: Flat + DomainBounds<D>,
+    L: IncrementalLaw,
+    L::State: FlatState,
+    T: Transfer<D>,
+    T::PointState: FlatState,
+    K: DilatationTreatment,
+    R: DomainUpdater<D, B::Domain>,
+{
+    let last_energies = solver.energies(points)?;
+    let scale = clock.scale;
+    let drift = last_energies.total() - clock.initial.total();
+    Ok(ExplicitOutput {
+        last: snapshot_of(points, initial_position, solver.time()),
+        steps: solver.steps(),
+        time: solver.time(),
+        outputs: 0,
+        initial: clock.initial,
+        last_energies,
+        energy_scale: scale,
+        energy_drift: if scale > 0.0 { drift / scale } else { 0.0 },
+        wall_time_s: 0.0,
+        stage_times: ExplicitStageTimes::default(),
+    })
 }
 
 /// Sets the forces of the loads with a curve to their values at time `t`

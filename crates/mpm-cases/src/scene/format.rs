@@ -492,37 +492,7 @@ pub enum SolverKind {
     Explicit,
 }
 
-/// `solver.transfer`: how the explicit solver carries velocities between
-/// points and grid (`mpm_solver::explicit::Transfer`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum TransferKind {
-    /// Particle-in-cell (α = 0): dissipative.
-    Pic,
-    /// Fluid-implicit-particle (α = 1), the default.
-    #[default]
-    Flip,
-    /// The PIC/FLIP blend with FLIP fraction `alpha`.
-    Blend,
-    /// Taylor-PIC: PIC with the points' velocity gradients in the momentum
-    /// projection.
-    Tpic,
-    /// Taylor-FLIP.
-    Tflip,
-}
-
-impl TransferKind {
-    /// The name in scene files.
-    pub fn name(self) -> &'static str {
-        match self {
-            TransferKind::Pic => "pic",
-            TransferKind::Flip => "flip",
-            TransferKind::Blend => "blend",
-            TransferKind::Tpic => "tpic",
-            TransferKind::Tflip => "tflip",
-        }
-    }
-}
+pub use crate::variant::TransferKind;
 
 /// `[solver]`. The keys of one solver kind are refused with the other
 /// ([`super::build`]): Newton and load-stepping keys with `kind =

@@ -5,47 +5,11 @@
 use mpm_constitutive::IncrementalLaw;
 use nalgebra::{Matrix3, SMatrix, SVector};
 
-use super::grid_update::GridState;
+use super::grid::GridState;
+pub use super::grid::{Gathered, gather_node};
 use crate::domain::DomainError;
 use crate::error::PointFailure;
 use crate::mesh::NodalMesh;
-
-/// The grid fields interpolated at a point.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Gathered<const D: usize> {
-    /// $\sum_i w_{ip}\tilde v^{n+1}_i$.
-    pub new_velocity: SVector<f64, D>,
-    /// $\sum_i w_{ip}v^n_i$.
-    pub old_velocity: SVector<f64, D>,
-    /// $\nabla v_p = \sum_i \tilde v^{n+1}_i\otimes\nabla w_{ip}$ (eq. 38).
-    pub grad: SMatrix<f64, D, D>,
-}
-
-/// Adds the contribution of node `i` with weight `w` and weight gradient
-/// `dw` to the interpolated fields.
-#[inline(always)]
-pub fn gather_node<const D: usize>(
-    g: &mut Gathered<D>,
-    grid: &GridState<D>,
-    i: usize,
-    w: f64,
-    dw: &SVector<f64, D>,
-) {
-    let node = &grid.velocity[i];
-    g.new_velocity += node.new * w;
-    g.old_velocity += node.old * w;
-    g.grad += node.new * dw.transpose();
-}
-
-impl<const D: usize> Default for Gathered<D> {
-    fn default() -> Self {
-        Self {
-            new_velocity: SVector::zeros(),
-            old_velocity: SVector::zeros(),
-            grad: SMatrix::zeros(),
-        }
-    }
-}
 
 /// The point's new velocity by the blend of eq. (36) and its new position
 /// by the second-order update of Nairn & Hammerquist (2021),

@@ -1,66 +1,14 @@
 //! Stage 2, the grid update: nodal velocity (eq. 30), acceleration (eq.
 //! 31), updated velocity (eq. 32) and the velocity fixities.
 
-use nalgebra::SVector;
 use rayon::prelude::*;
 
 use super::fixities::VelocityFixities;
-use super::p2g::{GridBuffer, NodeSums};
+use super::grid::{GridBuffer, NodeSums};
+pub use super::grid::{GridState, NodeVelocity};
 
 /// Nodes per parallel task of the grid update.
 const NODES_PER_TASK: usize = 4096;
-
-/// The velocities of one node, stored together (one cache line per node
-/// read by the grid-to-point stage).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NodeVelocity<const D: usize> {
-    /// $v^n_i$.
-    pub old: SVector<f64, D>,
-    /// $\tilde v^{n+1}_i$.
-    pub new: SVector<f64, D>,
-}
-
-impl<const D: usize> Default for NodeVelocity<D> {
-    fn default() -> Self {
-        Self {
-            old: SVector::zeros(),
-            new: SVector::zeros(),
-        }
-    }
-}
-
-/// The grid velocities of a step: $v^n_i = p_i/m_i$ (eq. 30) and
-/// $\tilde v^{n+1}_i = v^n_i + \Delta t\,(f^{ext}_i + f^{int}_i)/m_i$ (eqs.
-/// 31–32). Entries outside `lo..hi` are stale and never read.
-#[derive(Debug, Clone, Default)]
-pub struct GridState<const D: usize> {
-    /// Lumped mass $m_i$.
-    pub mass: Vec<f64>,
-    /// The velocities.
-    pub velocity: Vec<NodeVelocity<D>>,
-    /// First node with mass.
-    pub lo: usize,
-    /// One past the last node with mass.
-    pub hi: usize,
-}
-
-impl<const D: usize> GridState<D> {
-    /// A grid of `nodes` nodes.
-    pub fn new(nodes: usize) -> Self {
-        Self {
-            mass: vec![0.0; nodes],
-            velocity: vec![NodeVelocity::default(); nodes],
-            lo: 0,
-            hi: 0,
-        }
-    }
-
-    /// The nodal acceleration $a_i = (\tilde v^{n+1}_i - v^n_i)/\Delta t$,
-    /// which after the fixities is the recomputed one of the notes.
-    pub fn acceleration(&self, node: usize, dt: f64) -> SVector<f64, D> {
-        (self.velocity[node].new - self.velocity[node].old) / dt
-    }
-}
 
 /// Sums the threads' `buffers` into `grid` and updates the velocities
 /// (eqs. 30–32); nodes without mass get zero velocity. Then the fixities:

@@ -32,6 +32,7 @@ pub mod dilatation;
 pub mod energy;
 pub mod fixities;
 pub mod g2p;
+pub mod grid;
 pub mod grid_update;
 pub mod mesh;
 pub mod options;

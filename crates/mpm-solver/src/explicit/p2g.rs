@@ -6,73 +6,9 @@ use std::ops::Range;
 use mpm_basis::{BasisFunction, Stencil};
 use nalgebra::{Matrix3, SVector};
 
+pub use super::grid::{GridBuffer, NodeSums};
 use super::transfer::Transfer;
 use crate::error::{BasisFailure, PointFailure};
-
-/// The sums of one node, stored together so that a point's update of a
-/// node touches one cache line rather than three.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NodeSums<const D: usize> {
-    /// $m_i$ (eq. 28).
-    pub mass: f64,
-    /// $p_i = m_i v_i$ (eq. 29).
-    pub momentum: SVector<f64, D>,
-    /// $f^{ext}_i + f^{int}_i$ (eqs. 20–21).
-    pub force: SVector<f64, D>,
-}
-
-impl<const D: usize> NodeSums<D> {
-    /// Nothing.
-    pub const ZERO: Self = Self {
-        mass: 0.0,
-        momentum: SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
-        force: SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; D]; 1])),
-    };
-}
-
-/// Nodal sums of one thread's points. The array spans the whole mesh; only
-/// `lo..hi`, the nodes touched since the last [`GridBuffer::clear`], can be
-/// non-zero, so a thread whose points are spatially coherent clears and
-/// reduces little more than its share of the grid.
-#[derive(Debug, Clone)]
-pub struct GridBuffer<const D: usize> {
-    /// The sums per node.
-    pub nodes: Vec<NodeSums<D>>,
-    /// First touched node.
-    pub lo: usize,
-    /// One past the last touched node.
-    pub hi: usize,
-}
-
-impl<const D: usize> GridBuffer<D> {
-    /// Zeroed sums for `nodes` nodes.
-    pub fn new(nodes: usize) -> Self {
-        Self {
-            nodes: vec![NodeSums::ZERO; nodes],
-            lo: usize::MAX,
-            hi: 0,
-        }
-    }
-
-    /// Zeroes the touched range.
-    pub fn clear(&mut self) {
-        if self.lo < self.hi {
-            self.nodes[self.lo..self.hi].fill(NodeSums::ZERO);
-        }
-        self.lo = usize::MAX;
-        self.hi = 0;
-    }
-
-    /// Number of nodes.
-    pub fn len(&self) -> usize {
-        self.nodes.len()
-    }
-
-    /// Whether the buffer has no nodes.
-    pub fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
-    }
-}
 
 /// What the scatter reads from the points.
 #[derive(Debug, Clone, Copy)]

@@ -25,9 +25,7 @@
 use mpm_basis::TensorFactors;
 use nalgebra::{SMatrix, SVector};
 
-use super::g2p::Gathered;
-use super::grid_update::GridState;
-use super::p2g::NodeSums;
+use super::grid::{Gathered, GridState, NodeSums};
 
 /// One combination of the non-first axes: the id of its first node along
 /// axis 0, the outer weight $o$, the outer partials $\partial_k o$ (entry 0

@@ -217,7 +217,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             self.locking
                 .assign(&self.mesh, input, &mut self.patches.assignment)?;
             self.patches.build(sys);
-            sys.build_patch_neighbours(&self.patches);
+            let patches = &self.patches;
+            sys.build_neighbours_from(|w, push| patches.neighbours(w, push));
         } else {
             sys.build_neighbours();
         }

@@ -274,7 +274,7 @@ fn node_pass<const D: usize, const FORCE: bool>(
 /// h_{vp,i}\,(\mathbf G_{wP} - \mathbf g_{wp})_k$ over the points $p$ of
 /// every patch $P$ whose node union holds $w$ ([`PatchSystem`]; the
 /// pattern must be the patch pattern of
-/// [`StepSystem::build_patch_neighbours`], each entry placed through
+/// [`PatchSystem::neighbours`], each entry placed through
 /// [`PatchSystem::place`]). One block column per task,
 /// patches and points ascending, so the sums do not depend on the thread
 /// count.

@@ -204,8 +204,21 @@ impl<const D: usize> PatchSystem<D> {
         self.patch_grad.resize(self.union.len(), SVector::zeros());
     }
 
+    /// The neighbours of node `w` in a patch-coupled step, into `push`:
+    /// the nodes sharing a patch with it (a superset of the nodes sharing
+    /// a point, since a patch's union holds its points' stencils). The
+    /// system builds its lists from it
+    /// ([`StepSystem::build_neighbours_from`]).
+    pub fn neighbours(&self, w: usize, push: &mut dyn FnMut(u32)) {
+        for &(k, _) in &self.node_patches[self.node_ptr[w]..self.node_ptr[w + 1]] {
+            for &v in self.union_of(k as usize) {
+                push(v);
+            }
+        }
+    }
+
     /// The placement table [`Self::place`], once per step after the
-    /// patch neighbour lists ([`StepSystem::build_patch_neighbours`]).
+    /// patch neighbour lists ([`Self::neighbours`]).
     /// Every pair of a union is a neighbour pair by construction.
     pub fn build_placement(&mut self, sys: &StepSystem<D>) {
         self.place.clear();

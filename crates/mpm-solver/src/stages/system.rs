@@ -6,8 +6,6 @@
 
 use nalgebra::SVector;
 
-use crate::stages::patch::PatchSystem;
-
 /// Marker for "none" in the `u32` index maps.
 pub const NONE: u32 = u32::MAX;
 
@@ -177,21 +175,17 @@ impl<const D: usize> StepSystem<D> {
         );
     }
 
-    /// Sorted neighbour lists of a patch-coupled step: nodes sharing a
-    /// patch (a superset of the nodes sharing a point, since a patch's
-    /// union holds its points' stencils).
-    pub fn build_patch_neighbours(&mut self, patches: &PatchSystem<D>) {
+    /// Sorted, duplicate-free neighbour lists of the nodes that
+    /// `neighbours(w, push)` pushes for every node `w`: the hook through
+    /// which a coupled locking treatment gives its wider pattern
+    /// ([`crate::stages::patch::PatchSystem::neighbours`]: nodes sharing
+    /// a patch), as [`Self::extend_neighbours`] is the ghost penalty's.
+    pub fn build_neighbours_from(&mut self, neighbours: impl Fn(usize, &mut dyn FnMut(u32))) {
         neighbour_lists(
             self.active.len(),
             &mut self.nb_ptr,
             &mut self.nb,
-            |w, push| {
-                for &(k, _) in &patches.node_patches[patches.node_ptr[w]..patches.node_ptr[w + 1]] {
-                    for &v in patches.union_of(k as usize) {
-                        push(v);
-                    }
-                }
-            },
+            neighbours,
         );
     }
 
