@@ -166,11 +166,7 @@ macro_rules! register_laws {
             fn return_map(&self, trial: &SymSpectral, history: &SceneHistory) -> LawState<SceneHistory> {
                 match self {
                     $(SceneLaw::$variant(law) => {
-                        #[allow(unreachable_patterns)]
-                        let h = match history {
-                            SceneHistory::$variant(h) => *h,
-                            _ => Default::default(),
-                        };
+                        let h = own_history!($variant, history);
                         let s = law.return_map(trial, &h);
                         LawState {
                             tau: s.tau,
@@ -222,11 +218,7 @@ macro_rules! register_laws {
             fn point_shear_modulus(&self, history: &SceneHistory) -> Option<f64> {
                 match self {
                     $(SceneLaw::$variant(law) => {
-                        #[allow(unreachable_patterns)]
-                        let h = match history {
-                            SceneHistory::$variant(h) => *h,
-                            _ => Default::default(),
-                        };
+                        let h = own_history!($variant, history);
                         law.point_shear_modulus(&h)
                     })+
                 }
@@ -235,11 +227,7 @@ macro_rules! register_laws {
             fn stored_energy(&self, elastic_strain: &Vector3<f64>, history: &SceneHistory) -> Option<f64> {
                 match self {
                     $(SceneLaw::$variant(law) => {
-                        #[allow(unreachable_patterns)]
-                        let h = match history {
-                            SceneHistory::$variant(h) => *h,
-                            _ => Default::default(),
-                        };
+                        let h = own_history!($variant, history);
                         law.stored_energy(elastic_strain, &h)
                     })+
                 }
@@ -254,23 +242,26 @@ macro_rules! register_laws {
 /// default history).
 macro_rules! inner_state {
     ($variant:ident, $history:expr, $state:expr) => {{
+        let s = LawState {
+            tau: $state.tau,
+            elastic_strain: $state.elastic_strain,
+            history: own_history!($variant, &$state.history),
+            yielded: $state.yielded,
+        };
+        (own_history!($variant, $history), s)
+    }};
+}
+
+/// The history of law variant `$variant` in the [`SceneHistory`]
+/// `$history` (a reference), or the law's default for another variant's.
+macro_rules! own_history {
+    ($variant:ident, $history:expr) => {{
         #[allow(unreachable_patterns)]
         let h = match $history {
             SceneHistory::$variant(h) => *h,
             _ => Default::default(),
         };
-        #[allow(unreachable_patterns)]
-        let inner = match $state.history {
-            SceneHistory::$variant(h) => h,
-            _ => Default::default(),
-        };
-        let s = LawState {
-            tau: $state.tau,
-            elastic_strain: $state.elastic_strain,
-            history: inner,
-            yielded: $state.yielded,
-        };
-        (h, s)
+        h
     }};
 }
 

@@ -349,6 +349,14 @@ impl<const D: usize> Run<'_, '_, D> {
                 k as f64 * setup.output_interval
             }
         };
+        let reached = |solver: &ExplicitSolver<D, B, L, T, K, R>, points: &PointsOf<D, B, L, T>| {
+            Ok::<_, SolverError>(Reached {
+                time: solver.time(),
+                steps: solver.steps(),
+                energies: solver.energies(points)?,
+                external_work: solver.external_work(),
+            })
+        };
         let mut wall = Wall::default();
         let mut run = Outputs {
             initial_position: &self.problem.position,
@@ -361,7 +369,7 @@ impl<const D: usize> Run<'_, '_, D> {
                 points = resumed;
                 clock
             }
-            None => run.start(&solver, &points, &mut wall)?,
+            None => run.start(&points, solver.energies(&points)?, &mut wall)?,
         };
         let session_start = *solver.stage_times();
         while clock.index < outputs {
@@ -373,9 +381,14 @@ impl<const D: usize> Run<'_, '_, D> {
                 let info = solver.step(&mut points, target - solver.time())?;
                 wall.observe(|| (run.observer)(ExplicitEvent::Step(info)))?;
             }
-            run.output(&solver, &points, &mut clock, &mut wall)?;
+            run.output(&points, &reached(&solver, &points)?, &mut clock, &mut wall)?;
         }
-        let mut out = summary(&solver, &points, &clock, &self.problem.position)?;
+        let mut out = summary(
+            &points,
+            &reached(&solver, &points)?,
+            &clock,
+            &self.problem.position,
+        );
         out.outputs = outputs + 1;
         out.wall_time_s = wall.so_far();
         let stage = solver.stage_times();
@@ -476,57 +489,43 @@ struct Outputs<'a, 'o, const D: usize> {
 }
 
 impl<const D: usize> Outputs<'_, '_, D> {
-    /// Output 0, the initial state, and the clock that starts from it.
-    fn start<B, L, T, K, R>(
+    /// Output 0, the initial state with its `energies`, and the clock that
+    /// starts from it.
+    fn start<S: FlatState, T: FlatState, Dom: Flat + DomainBounds<D>>(
         &mut self,
-        solver: &ExplicitSolver<D, B, L, T, K, R>,
-        points: &PointsOf<D, B, L, T>,
+        points: &ExplicitPoints<D, S, T, Dom>,
+        energies: Energies,
         wall: &mut Wall,
-    ) -> Result<Clock, SolverError>
-    where
-        B: BasisFunction<D, Mesh = RegularGrid<D>>,
-        B::Domain: Flat + DomainBounds<D>,
-        L: IncrementalLaw,
-        L::State: FlatState,
-        T: Transfer<D>,
-        T::PointState: FlatState,
-        K: DilatationTreatment,
-        R: DomainUpdater<D, B::Domain>,
-    {
-        let initial = solver.energies(points)?;
+    ) -> Result<Clock, SolverError> {
         let clock = Clock {
             index: 0,
             external_work: 0.0,
-            initial,
-            scale: initial.kinetic + initial.strain,
+            initial: energies,
+            scale: energies.kinetic + energies.strain,
         };
-        self.frame(points, 0.0, 0, initial, &clock, wall)?;
+        let at = Reached {
+            time: 0.0,
+            steps: 0,
+            energies,
+            external_work: 0.0,
+        };
+        self.frame(points, &at, &clock, wall)?;
         Ok(clock)
     }
 
-    /// The next output: the clock advanced to it, the observer shown it.
-    fn output<B, L, T, K, R>(
+    /// The next output, reached at `at`: the clock advanced to it, the
+    /// observer shown it.
+    fn output<S: FlatState, T: FlatState, Dom: Flat + DomainBounds<D>>(
         &mut self,
-        solver: &ExplicitSolver<D, B, L, T, K, R>,
-        points: &PointsOf<D, B, L, T>,
+        points: &ExplicitPoints<D, S, T, Dom>,
+        at: &Reached,
         clock: &mut Clock,
         wall: &mut Wall,
-    ) -> Result<(), SolverError>
-    where
-        B: BasisFunction<D, Mesh = RegularGrid<D>>,
-        B::Domain: Flat + DomainBounds<D>,
-        L: IncrementalLaw,
-        L::State: FlatState,
-        T: Transfer<D>,
-        T::PointState: FlatState,
-        K: DilatationTreatment,
-        R: DomainUpdater<D, B::Domain>,
-    {
-        let energies = solver.energies(points)?;
+    ) -> Result<(), SolverError> {
         clock.index += 1;
-        clock.external_work = solver.external_work();
-        clock.scale = clock.scale.max(energies.kinetic + energies.strain);
-        self.frame(points, solver.time(), solver.steps(), energies, clock, wall)
+        clock.external_work = at.external_work;
+        clock.scale = clock.scale.max(at.energies.kinetic + at.energies.strain);
+        self.frame(points, at, clock, wall)
     }
 
     /// Shows the observer output `clock.index` (its time excluded from the
@@ -534,9 +533,7 @@ impl<const D: usize> Outputs<'_, '_, D> {
     fn frame<S: FlatState, T: FlatState, Dom: Flat + DomainBounds<D>>(
         &mut self,
         points: &ExplicitPoints<D, S, T, Dom>,
-        time: f64,
-        steps: usize,
-        energies: Energies,
+        at: &Reached,
         clock: &Clock,
         wall: &mut Wall,
     ) -> Result<(), SolverError> {
@@ -544,51 +541,49 @@ impl<const D: usize> Outputs<'_, '_, D> {
         let (initial, control) = (self.initial_position, self.control);
         let observer = &mut *self.observer;
         wall.observe(|| {
-            let snapshot = snapshot(points, initial, time, control, steps, clock, so_far);
+            let snapshot = snapshot(points, initial, at.time, control, at.steps, clock, so_far);
             observer(ExplicitEvent::Output(ExplicitFrame {
                 index: clock.index,
-                time,
-                steps,
-                energies,
+                time: at.time,
+                steps: at.steps,
+                energies: at.energies,
                 snapshot: &snapshot,
             }))
         })
     }
 }
 
-/// The run's final state and energies (the caller adds the counts and
-/// times of this session).
-fn summary<const D: usize, B, L, T, K, R>(
-    solver: &ExplicitSolver<D, B, L, T, K, R>,
-    points: &PointsOf<D, B, L, T>,
+/// Where the solver stands at an output.
+#[derive(Debug, Clone, Copy)]
+struct Reached {
+    time: f64,
+    steps: usize,
+    energies: Energies,
+    external_work: f64,
+}
+
+/// The run's final state at `at` (the caller adds the counts and times of
+/// this session).
+fn summary<const D: usize, S: FlatState, T: FlatState, Dom: DomainBounds<D>>(
+    points: &ExplicitPoints<D, S, T, Dom>,
+    at: &Reached,
     clock: &Clock,
     initial_position: &[SVector<f64, D>],
-) -> Result<ExplicitOutput, SolverError>
-where
-    B: BasisFunction<D, Mesh = RegularGrid<D>>,
-    B::Domain: Flat + DomainBounds<D>,
-    L: IncrementalLaw,
-    L::State: FlatState,
-    T: Transfer<D>,
-    T::PointState: FlatState,
-    K: DilatationTreatment,
-    R: DomainUpdater<D, B::Domain>,
-{
-    let last_energies = solver.energies(points)?;
+) -> ExplicitOutput {
     let scale = clock.scale;
-    let drift = last_energies.total() - clock.initial.total();
-    Ok(ExplicitOutput {
-        last: snapshot_of(points, initial_position, solver.time()),
-        steps: solver.steps(),
-        time: solver.time(),
+    let drift = at.energies.total() - clock.initial.total();
+    ExplicitOutput {
+        last: snapshot_of(points, initial_position, at.time),
+        steps: at.steps,
+        time: at.time,
         outputs: 0,
         initial: clock.initial,
-        last_energies,
+        last_energies: at.energies,
         energy_scale: scale,
         energy_drift: if scale > 0.0 { drift / scale } else { 0.0 },
         wall_time_s: 0.0,
         stage_times: ExplicitStageTimes::default(),
-    })
+    }
 }
 
 /// Sets the forces of the loads with a curve to their values at time `t`
