@@ -4,6 +4,9 @@
 //! sections happens here, before anything is run or written, and each
 //! error names the place in the file (or the override) it comes from.
 
+mod outputs;
+mod solver;
+
 use std::collections::BTreeMap;
 
 use mpm_mesh::{RegularGrid, SimplexMesh};
@@ -20,8 +23,8 @@ use crate::scene_file::SceneSource;
 use crate::variant::{BasisKind, DomainUpdateKind, LockingKind, Variant};
 
 use super::format::{
-    BoundaryKind, Field, LinearKind, LoadKind, MeshKind, MotionKind, Placement, RegionSpec, Scene,
-    SolverKind, SolverSpec, TransferKind,
+    BoundaryKind, Field, LoadKind, MeshKind, MotionKind, Placement, RegionSpec, Scene, SolverKind,
+    SolverSpec, TransferKind,
 };
 use super::region::{Region, point};
 
@@ -1803,204 +1806,13 @@ impl<const D: usize> Problem<D> {
 
         // Solver.
         let s = &scene.solver;
-        let steps = check.at_least(&s.steps, 1, "solver `steps`")?;
-        let initial = 1.0 / steps as f64;
-        let max = match &s.max_increment {
-            Some(v) => check.positive(v, "solver `max_increment`")?,
-            None => initial,
-        };
-        let min = match &s.min_increment {
-            Some(v) => check.positive(v, "solver `min_increment`")?,
-            None => initial / 1024.0,
-        };
-        if !(min <= initial && initial <= max && max <= 1.0) {
-            let at = s.max_increment.as_ref().or(s.min_increment.as_ref());
-            return Err(src.error(
-                at.map(Spanned::span),
-                &format!("load increments need min_increment ({min}) <= 1/steps ({initial}) <= max_increment ({max}) <= 1"),
-            ));
-        }
-        if min < mpm_solver::MIN_LOAD_INCREMENT {
-            let at = s
-                .min_increment
-                .as_ref()
-                .map_or(s.steps.span(), Spanned::span);
-            return Err(src.error(
-                Some(at),
-                &format!(
-                    "load increments below {:e} would not move the load factor (min_increment {min:e}: 1/steps / 1024 by default)",
-                    mpm_solver::MIN_LOAD_INCREMENT
-                ),
-            ));
-        }
-        let tolerance = check.positive(&s.tolerance, "solver `tolerance`")?;
-        let max_iterations = check.at_least(&s.max_iterations, 1, "solver `max_iterations`")?;
-        let defaults = NewtonOptions::default();
-        let fraction = |value: &Option<Spanned<f64>>, default: f64, key: &str| {
-            match value {
-            None => Ok(default),
-            Some(v) if (0.0..1.0).contains(v.get_ref()) => Ok(*v.get_ref()),
-            Some(v) => Err(src.at(
-                v,
-                format!(
-                    "solver `{key}` is a fraction of the largest node's, in [0, 1) (0 disables the rule), got {}",
-                    v.get_ref()
-                ),
-            )),
-        }
-        };
-        let weak_node_threshold = fraction(
-            &s.weak_node_threshold,
-            defaults.weak_node_threshold,
-            "weak_node_threshold",
-        )?;
-        let weak_node_stiffness = fraction(
-            &s.weak_node_stiffness,
-            defaults.weak_node_stiffness,
-            "weak_node_stiffness",
-        )?;
-        let ghost = match (&s.ghost_penalty, &s.ghost_fill) {
-            (None, Some(f)) => {
-                return Err(src.at(f, "solver `ghost_fill` applies with `ghost_penalty`"));
-            }
-            (None, None) => mpm_solver::GhostPenalty::OFF,
-            (Some(g), fill) => {
-                if !(g.get_ref().is_finite() && *g.get_ref() >= 0.0) {
-                    return Err(src.at(
-                        g,
-                        format!(
-                            "solver `ghost_penalty` is a multiple of the law's 2μ, >= 0 (0 disables it), got {}",
-                            g.get_ref()
-                        ),
-                    ));
-                }
-                if *g.get_ref() > 0.0 && !matches!(mesh, SceneMesh::Grid(_)) {
-                    return Err(src.at(
-                        g,
-                        "solver `ghost_penalty` acts on the faces of a regular grid's cells ([mesh] kind = \"grid\")",
-                    ));
-                }
-                let fill = match fill {
-                    None => mpm_solver::GhostPenalty::OFF.fill,
-                    Some(f) if *f.get_ref() > 0.0 && *f.get_ref() <= 1.0 => *f.get_ref(),
-                    Some(f) => {
-                        return Err(src.at(
-                            f,
-                            format!(
-                                "solver `ghost_fill` is a fraction of a cell's volume in (0, 1], got {}",
-                                f.get_ref()
-                            ),
-                        ));
-                    }
-                };
-                mpm_solver::GhostPenalty {
-                    factor: *g.get_ref(),
-                    fill,
-                }
-            }
-        };
-        let linear = {
-            let mut iterative = mpm_solver::IterativeOptions::default();
-            if let Some(t) = &s.linear_tolerance {
-                let t = check.positive(t, "solver `linear_tolerance`")?;
-                if t >= 1.0 {
-                    return Err(src.at(
-                        s.linear_tolerance.as_ref().map_or(&s.tolerance, |t| t),
-                        "solver `linear_tolerance` must be below 1 (a relative residual)",
-                    ));
-                }
-                iterative.rel_tolerance = t;
-            }
-            match *s.linear.get_ref() {
-                LinearKind::Direct => mpm_solver::LinearChoice::Direct,
-                LinearKind::Iterative => mpm_solver::LinearChoice::Iterative(iterative),
-                LinearKind::Auto => mpm_solver::LinearChoice::Auto {
-                    max_direct_dofs: s.max_direct_dofs.as_ref().map(|m| *m.get_ref()),
-                    iterative,
-                },
-            }
-        };
-        if let Some(t) = &s.linear_tolerance
-            && *s.linear.get_ref() == LinearKind::Direct
-        {
-            return Err(src.at(
-                t,
-                "solver `linear_tolerance` applies to the iterative solver (`linear = \"iterative\"` or `\"auto\"`) only",
-            ));
-        }
-        if let Some(m) = &s.max_direct_dofs
-            && *s.linear.get_ref() != LinearKind::Auto
-        {
-            return Err(src.at(
-                m,
-                "solver `max_direct_dofs` applies to `linear = \"auto\"` only",
-            ));
-        }
+        let (stepping, newton) =
+            solver::newton_and_stepping(s, src, matches!(mesh, SceneMesh::Grid(_)))?;
 
         // Outputs.
         let o = &scene.output;
-        let every = check.at_least(&o.every, 1, "output `every`")?;
-        if explicit {
-            if SolverSpec::given(&o.every) {
-                return Err(src.at(
-                    &o.every,
-                    "output `every` counts the implicit solver's load steps; an explicit run writes every [solver] `output_interval` of simulated time",
-                ));
-            }
-            if let Some(r) = o.reactions.first() {
-                return Err(src.at(
-                    &r.name,
-                    "reaction outputs are the implicit solver's nodal reactions; the explicit solver does not compute them",
-                ));
-            }
-        }
-        let safe = |name: &Spanned<String>| -> Result<String, CasesError> {
-            let v = name.get_ref();
-            // 200 bytes leave room for the suffixes within the 255 of a
-            // file name on common file systems.
-            if v.is_empty()
-                || v.len() > 200
-                || !v
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-            {
-                return Err(src.at(
-                    name,
-                    "an output name must be 1 to 200 letters, digits, `_` or `-` (it names a file)",
-                ));
-            }
-            Ok(v.clone())
-        };
-        unique_names(o.reactions.iter().map(|r| &r.name), "reaction output", src)?;
-        unique_names(o.probes.iter().map(|r| &r.name), "probe output", src)?;
-        let reactions = o
-            .reactions
-            .iter()
-            .map(|r| {
-                Ok(ReactionOutput {
-                    name: safe(&r.name)?,
-                    nodes: set_of(&r.set)?.clone(),
-                    about: match &r.about {
-                        Some(a) => Some(point::<D>(a, "reaction `about`", src)?),
-                        None => None,
-                    },
-                })
-            })
-            .collect::<Result<Vec<_>, CasesError>>()?;
-        let probes = o
-            .probes
-            .iter()
-            .map(|p| {
-                Ok((
-                    safe(&p.name)?,
-                    nearest(&point::<D>(&p.at, "probe `at`", src)?),
-                ))
-            })
-            .collect::<Result<Vec<_>, CasesError>>()?;
-        if o.png && D != 2 {
-            return Err(src.error(None, "output `png` draws 2D scenes only"));
-        }
-        let fields = o.fields.clone().unwrap_or_else(|| Field::ALL.to_vec());
+        let (every, reactions, probes, fields) =
+            outputs::outputs::<D>(o, explicit, src, &set_of, &nearest)?;
         // A CFL step is h / max(c + |v|) over the initial points (the
         // solver computes the signal speed once): the fixed `time_step`'s
         // bound of 1e9 steps, applied before running.
@@ -2121,18 +1933,8 @@ impl<const D: usize> Problem<D> {
             point_forces,
             curved,
             manufactured,
-            stepping: LoadStepping { initial, max, min },
-            newton: NewtonOptions {
-                tolerance,
-                max_iterations,
-                predictor: *s.predictor.get_ref(),
-                first_tangent: (*s.first_tangent.get_ref()).into(),
-                linear,
-                weak_node_threshold,
-                weak_node_stiffness,
-                ghost,
-                ..NewtonOptions::default()
-            },
+            stepping,
+            newton,
             variant,
             patch_of_element,
             reactions,
