@@ -423,6 +423,25 @@ pub type CubePoints = PointsFor<3, NeoHookean, Taylor>;
 /// # Errors
 /// `n` < 8; set-up errors.
 pub fn elastic_cube(n: usize) -> Result<(CubeSolver, CubePoints), SolverError> {
+    elastic_cube_with(n, NeoHookean::new(1e6, 0.3)?)
+}
+
+/// [`elastic_cube`] with the law `law` (its wave speed sets the time
+/// step): a downstream crate's law, or the same Neo-Hookean behind a
+/// run-time choice, on the same cube.
+///
+/// # Errors
+/// As [`elastic_cube`].
+pub fn elastic_cube_with<L: IncrementalLaw>(
+    n: usize,
+    law: L,
+) -> Result<
+    (
+        ExplicitSolver<3, QuadraticBSpline, L, Taylor, NoLocking>,
+        PointsFor<3, L, Taylor>,
+    ),
+    SolverError,
+> {
     if n < 8 {
         return Err(SolverError::InvalidInput(format!(
             "the cube needs at least 8 cells per axis, not {n}"
@@ -446,8 +465,7 @@ pub fn elastic_cube(n: usize) -> Result<(CubeSolver, CubePoints), SolverError> {
         }
     }
     let volume = vec![d * d * d; x.len()];
-    let points: CubePoints = ExplicitPoints::new(x, volume, 1000.0)?;
-    let law = NeoHookean::new(1e6, 0.3)?;
+    let points: PointsFor<3, L, Taylor> = ExplicitPoints::new(x, volume, 1000.0)?;
     let c = (law.p_wave_modulus() / 1000.0).sqrt();
     let mut walls = VelocityFixities::new();
     let nodes = n + 1;
