@@ -410,7 +410,9 @@ pub fn fixed_end_bar<B: BasisFunction<2, Domain = (), Mesh = RegularGrid<2>>>(
 }
 
 /// The solver of the cube scene.
-pub type CubeSolver = ExplicitSolver<3, QuadraticBSpline, NeoHookean, Taylor, NoLocking>;
+pub type CubeSolver = CubeSolverWith<NeoHookean>;
+/// The solver of [`elastic_cube_with`], with law `L`.
+pub type CubeSolverWith<L> = ExplicitSolver<3, QuadraticBSpline, L, Taylor, NoLocking>;
 /// Its points.
 pub type CubePoints = PointsFor<3, NeoHookean, Taylor>;
 
@@ -435,13 +437,7 @@ pub fn elastic_cube(n: usize) -> Result<(CubeSolver, CubePoints), SolverError> {
 pub fn elastic_cube_with<L: IncrementalLaw>(
     n: usize,
     law: L,
-) -> Result<
-    (
-        ExplicitSolver<3, QuadraticBSpline, L, Taylor, NoLocking>,
-        PointsFor<3, L, Taylor>,
-    ),
-    SolverError,
-> {
+) -> Result<(CubeSolverWith<L>, PointsFor<3, L, Taylor>), SolverError> {
     if n < 8 {
         return Err(SolverError::InvalidInput(format!(
             "the cube needs at least 8 cells per axis, not {n}"
