@@ -133,6 +133,14 @@ fn points<const D: usize, B: InitialDomain<D>, H: Copy + Default>(
     points
 }
 
+/// The scene's regular grid (every scene here is on one).
+fn grid_of<const D: usize>(p: &Problem<D>) -> RegularGrid<D> {
+    match &p.mesh {
+        scene::build::SceneMesh::Grid(g) => g.clone(),
+        scene::build::SceneMesh::Simplex(_) => unreachable!("grid scenes only"),
+    }
+}
+
 /// A deterministic increment of the free dofs, large enough (1 % strain
 /// at the grid spacing) that von Mises yields at the base.
 fn increment(n: usize, h: f64) -> Vec<f64> {
@@ -159,10 +167,7 @@ fn compare<const D: usize, B, L, U, V>(
     U: DomainUpdater<D, B::Domain>,
     V: DomainUpdater<D, B::Domain>,
 {
-    let grid = match &p.mesh {
-        scene::build::SceneMesh::Grid(g) => g.clone(),
-        scene::build::SceneMesh::Simplex(_) => unreachable!("grid scenes only"),
-    };
+    let grid = grid_of(p);
     let laws: SceneLaws = scene_laws(&[(p.materials[0].model, p.materials[0].params)]).unwrap();
     let scene_points = points::<D, B, _>(p, |_| Tagged::new(0, laws.laws()[0].initial_history()));
     let typed_points = points::<D, B, L::History>(p, |_| Default::default());
@@ -298,10 +303,7 @@ where
     L: LogStrainLaw,
     K: mpm_solver::LockingTreatment<D, RegularGrid<D>>,
 {
-    let grid = match &p.mesh {
-        scene::build::SceneMesh::Grid(g) => g.clone(),
-        scene::build::SceneMesh::Simplex(_) => unreachable!("grid scenes only"),
-    };
+    let grid = grid_of(p);
     let h = history(&law);
     let points = points::<D, LinearMpm, _>(p, |_| h);
     let mut solver: ImplicitSolver<D, Parts<LinearMpm, PreviouslyConverged, L, K, NoUpdate, _>> =
