@@ -4,6 +4,8 @@
 //! sections happens here, before anything is run or written, and each
 //! error names the place in the file (or the override) it comes from.
 
+mod curves;
+mod materials;
 mod outputs;
 mod solver;
 
@@ -18,7 +20,7 @@ use nalgebra::SVector;
 use toml::Spanned;
 
 use crate::CasesError;
-use crate::material::{MaterialModel, MaterialParams, SceneLaw};
+use crate::material::{MaterialModel, MaterialParams};
 use crate::scene_file::SceneSource;
 use crate::variant::{BasisKind, DomainUpdateKind, LockingKind, Variant};
 
@@ -852,45 +854,7 @@ impl<const D: usize> Problem<D> {
         let tol = 1e-9 * size.max();
 
         // Curves (index 0: the default ramp).
-        let curve_names = unique_names(scene.curves.iter().map(|c| &c.name), "curve", src)?;
-        let mut curves = vec![Curve::ramp()];
-        for c in &scene.curves {
-            let rows = c.points.get_ref();
-            if rows.is_empty() {
-                return Err(src.at(&c.points, "a curve needs at least one [time, factor] row"));
-            }
-            if let Some(k) = rows
-                .iter()
-                .position(|r| !(r[0].is_finite() && r[1].is_finite()))
-            {
-                return Err(src.at(
-                    &c.points,
-                    format!(
-                        "curve `{}`: row {} is [{}, {}]; times and factors must be finite",
-                        c.name.get_ref(),
-                        k + 1,
-                        rows[k][0],
-                        rows[k][1]
-                    ),
-                ));
-            }
-            if let Some(k) = (1..rows.len()).find(|&k| rows[k][0] <= rows[k - 1][0]) {
-                return Err(src.at(
-                    &c.points,
-                    format!(
-                        "curve `{}`: times must increase, but row {} has time {} after {}",
-                        c.name.get_ref(),
-                        k + 1,
-                        rows[k][0],
-                        rows[k - 1][0]
-                    ),
-                ));
-            }
-            curves.push(Curve { rows: rows.clone() });
-        }
-        if curves.len() > u16::MAX as usize {
-            return Err(src.error(None, "too many curves"));
-        }
+        let (curve_names, curves) = curves::curves(&scene.curves, src)?;
         let curve_of = |name: &Option<Spanned<String>>| -> Result<usize, CasesError> {
             match name {
                 None => Ok(0),
@@ -899,79 +863,7 @@ impl<const D: usize> Problem<D> {
         };
 
         // Materials.
-        let material_names =
-            unique_names(scene.materials.iter().map(|m| &m.name), "material", src)?;
-        if scene.materials.is_empty() {
-            return Err(src.error(None, "a scene needs at least one [[material]]"));
-        }
-        let plastic = scene
-            .materials
-            .iter()
-            .any(|m| m.model == MaterialModel::VonMises);
-        let mut materials: Vec<BuiltMaterial> = Vec::new();
-        for spec in &scene.materials {
-            let density = *spec.density.get_ref();
-            if density < 0.0 {
-                return Err(src.at(&spec.density, "density must be non-negative"));
-            }
-            if explicit && density <= 0.0 {
-                return Err(src.at(
-                    &spec.density,
-                    "the explicit solver needs a positive density (the points' masses set the wave speed and the time step)",
-                ));
-            }
-            let mut params = MaterialParams {
-                youngs_modulus: spec.youngs_modulus,
-                poisson_ratio: spec.poisson_ratio,
-                yield_stress: spec.yield_stress,
-                hardening: spec.hardening,
-            };
-            if spec.model != MaterialModel::VonMises && spec.yield_stress.is_some() {
-                return Err(src.at(
-                    &spec.name,
-                    format!(
-                        "material `{}`: yield_stress applies to model = von_mises",
-                        spec.name.get_ref()
-                    ),
-                ));
-            }
-            SceneLaw::new(spec.model, &params).map_err(|e| {
-                src.at(
-                    &spec.name,
-                    format!("material `{}`: {e}", spec.name.get_ref()),
-                )
-            })?;
-            let model = if plastic && spec.model == MaterialModel::Hencky {
-                params.yield_stress = Some(f64::MAX);
-                params.hardening = 0.0;
-                MaterialModel::VonMises
-            } else {
-                spec.model
-            };
-            // The materials of a scene share one law type (one
-            // monomorphised run); Hencky joins von Mises as a von Mises
-            // law that never yields, other mixtures are refused.
-            if let Some(first) = materials.first()
-                && first.model != model
-            {
-                return Err(src.at(
-                    &spec.name,
-                    format!(
-                        "material `{}` is {} but `{}` is {}: the materials of one scene share one model (hencky mixes with von_mises)",
-                        spec.name.get_ref(),
-                        spec.model,
-                        first.name,
-                        first.model
-                    ),
-                ));
-            }
-            materials.push(BuiltMaterial {
-                name: spec.name.get_ref().clone(),
-                model,
-                params,
-                density,
-            });
-        }
+        let (material_names, materials) = materials::materials(&scene.materials, explicit, src)?;
 
         // Bodies.
         if scene.bodies.is_empty() {

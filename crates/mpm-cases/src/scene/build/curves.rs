@@ -1,0 +1,60 @@
+//! The `[[curve]]` tables: load factor against time, each row checked at
+//! its curve; index 0 is the default ramp.
+
+use std::collections::BTreeMap;
+
+use super::{Curve, unique_names};
+use crate::CasesError;
+use crate::scene::format::CurveSpec;
+use crate::scene_file::SceneSource;
+
+/// The curves' names (for the loads' lookups; a name's index is its
+/// curve's minus one) and the curves, the default ramp first.
+///
+/// # Errors
+/// [`CasesError::Scene`] at the curve whose rows are wrong.
+pub(super) fn curves(
+    specs: &[CurveSpec],
+    src: &SceneSource,
+) -> Result<(BTreeMap<String, usize>, Vec<Curve>), CasesError> {
+    let curve_names = unique_names(specs.iter().map(|c| &c.name), "curve", src)?;
+    let mut curves = vec![Curve::ramp()];
+    for c in specs {
+        let rows = c.points.get_ref();
+        if rows.is_empty() {
+            return Err(src.at(&c.points, "a curve needs at least one [time, factor] row"));
+        }
+        if let Some(k) = rows
+            .iter()
+            .position(|r| !(r[0].is_finite() && r[1].is_finite()))
+        {
+            return Err(src.at(
+                &c.points,
+                format!(
+                    "curve `{}`: row {} is [{}, {}]; times and factors must be finite",
+                    c.name.get_ref(),
+                    k + 1,
+                    rows[k][0],
+                    rows[k][1]
+                ),
+            ));
+        }
+        if let Some(k) = (1..rows.len()).find(|&k| rows[k][0] <= rows[k - 1][0]) {
+            return Err(src.at(
+                &c.points,
+                format!(
+                    "curve `{}`: times must increase, but row {} has time {} after {}",
+                    c.name.get_ref(),
+                    k + 1,
+                    rows[k][0],
+                    rows[k - 1][0]
+                ),
+            ));
+        }
+        curves.push(Curve { rows: rows.clone() });
+    }
+    if curves.len() > u16::MAX as usize {
+        return Err(src.error(None, "too many curves"));
+    }
+    Ok((curve_names, curves))
+}
