@@ -2583,7 +2583,53 @@ fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>
             format!("solver `end_time` must be positive, got {end_time}"),
         ));
     }
-    let time_step = match (&s.cfl, &s.time_step) {
+    let time_step = explicit_time_step(s, src, end_time)?;
+    let transfer = s
+        .transfer
+        .as_ref()
+        .map_or(TransferKind::default(), |t| *t.get_ref());
+    let alpha = blend_alpha(s, src, transfer)?;
+    let output_interval = match &s.output_interval {
+        Some(o) => {
+            let value = *o.get_ref();
+            if value <= 0.0 {
+                return Err(src.at(
+                    o,
+                    format!("solver `output_interval` must be positive, got {value}"),
+                ));
+            }
+            if end_time / value > 1e6 {
+                return Err(src.at(
+                    o,
+                    format!("solver `output_interval` {value:e} would write more than 1e6 outputs before end_time {end_time}"),
+                ));
+            }
+            value
+        }
+        None => end_time / DEFAULT_OUTPUTS as f64,
+    };
+    Ok(Some(ExplicitKeys {
+        end_time,
+        output_interval,
+        time_step,
+        transfer,
+        alpha,
+        locking,
+    }))
+}
+
+/// The explicit time step of `s`: `cfl` or `time_step` (not both), a
+/// CFL factor of [`DEFAULT_CFL`] without either; `end_time` bounds the
+/// number of fixed steps.
+///
+/// # Errors
+/// [`CasesError::Scene`] at `cfl` or `time_step`.
+fn explicit_time_step(
+    s: &SolverSpec,
+    src: &SceneSource,
+    end_time: f64,
+) -> Result<mpm_solver::TimeStep, CasesError> {
+    Ok(match (&s.cfl, &s.time_step) {
         (Some(_), Some(dt)) => {
             return Err(src.at(
                 dt,
@@ -2616,69 +2662,51 @@ fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>
         (None, None) => mpm_solver::TimeStep::Cfl {
             factor: DEFAULT_CFL,
         },
-    };
-    let transfer = s
-        .transfer
-        .as_ref()
-        .map_or(TransferKind::default(), |t| *t.get_ref());
-    let alpha =
-        match (transfer, &s.alpha) {
-            (TransferKind::Blend, Some(a)) => {
-                let alpha = *a.get_ref();
-                if !(0.0..=1.0).contains(&alpha) {
-                    return Err(
-                        src.at(a, format!("solver `alpha` must lie in [0, 1], got {alpha}"))
-                    );
-                }
-                alpha
+    })
+}
+
+/// The FLIP fraction α of `transfer`: `alpha` for the blend (and only
+/// there), 0 for PIC and TPIC, 1 for FLIP and TFLIP.
+///
+/// # Errors
+/// [`CasesError::Scene`] at `alpha` or `transfer`.
+fn blend_alpha(
+    s: &SolverSpec,
+    src: &SceneSource,
+    transfer: TransferKind,
+) -> Result<f64, CasesError> {
+    Ok(match (transfer, &s.alpha) {
+        (TransferKind::Blend, Some(a)) => {
+            let alpha = *a.get_ref();
+            if !(0.0..=1.0).contains(&alpha) {
+                return Err(src.at(a, format!("solver `alpha` must lie in [0, 1], got {alpha}")));
             }
-            (TransferKind::Blend, None) => {
-                let at = s.transfer.as_ref().map_or(s.kind.span(), Spanned::span);
-                return Err(src.error(
-                    Some(at),
-                    "transfer = \"blend\" needs `alpha`, its FLIP fraction in [0, 1]",
-                ));
-            }
-            (other, Some(a)) => {
-                return Err(src.at(
+            alpha
+        }
+        (TransferKind::Blend, None) => {
+            let at = s.transfer.as_ref().map_or(s.kind.span(), Spanned::span);
+            return Err(src.error(
+                Some(at),
+                "transfer = \"blend\" needs `alpha`, its FLIP fraction in [0, 1]",
+            ));
+        }
+        (other, Some(a)) => {
+            return Err(src.at(
                 a,
                 format!(
                     "solver `alpha` applies to transfer = \"blend\" (transfer = \"{}\" has α = {})",
                     other.name(),
-                    if matches!(other, TransferKind::Pic | TransferKind::Tpic) { 0 } else { 1 }
+                    if matches!(other, TransferKind::Pic | TransferKind::Tpic) {
+                        0
+                    } else {
+                        1
+                    }
                 ),
             ));
-            }
-            (TransferKind::Pic | TransferKind::Tpic, None) => 0.0,
-            (TransferKind::Flip | TransferKind::Tflip, None) => 1.0,
-        };
-    let output_interval = match &s.output_interval {
-        Some(o) => {
-            let value = *o.get_ref();
-            if value <= 0.0 {
-                return Err(src.at(
-                    o,
-                    format!("solver `output_interval` must be positive, got {value}"),
-                ));
-            }
-            if end_time / value > 1e6 {
-                return Err(src.at(
-                    o,
-                    format!("solver `output_interval` {value:e} would write more than 1e6 outputs before end_time {end_time}"),
-                ));
-            }
-            value
         }
-        None => end_time / DEFAULT_OUTPUTS as f64,
-    };
-    Ok(Some(ExplicitKeys {
-        end_time,
-        output_interval,
-        time_step,
-        transfer,
-        alpha,
-        locking,
-    }))
+        (TransferKind::Pic | TransferKind::Tpic, None) => 0.0,
+        (TransferKind::Flip | TransferKind::Tflip, None) => 1.0,
+    })
 }
 
 /// The CFL factor of an explicit scene without `cfl` or `time_step`.
