@@ -21,7 +21,7 @@ use mpm_solver::{RunState, RunSummary};
 use serde::{Deserialize, Serialize};
 
 use crate::CasesError;
-use crate::output::atomic_write_with;
+use crate::output::{OutputError, atomic_write_with};
 use crate::run::Checkpoint;
 use crate::writer::WriterState;
 
@@ -87,10 +87,11 @@ pub fn write(
         .chain(&checkpoint.case_state)
         .find(|x| !x.is_finite())
     {
-        return Err(CasesError::NonFiniteField {
+        return Err(OutputError::NonFiniteField {
             field: "checkpoint".into(),
             value: *x,
-        });
+        }
+        .into());
     }
     let state = &checkpoint.state;
     let header = Header {
@@ -112,14 +113,14 @@ pub fn write(
         path: dir.join(FILE_NAME),
         source: std::io::Error::other(e),
     })?;
-    atomic_write_with(&dir.join(FILE_NAME), |w| {
+    Ok(atomic_write_with(&dir.join(FILE_NAME), |w| {
         writeln!(w, "{MAGIC}")?;
         writeln!(w, "{json}")?;
         for x in checkpoint.points.iter().chain(predictor) {
             w.write_all(&x.to_le_bytes())?;
         }
         Ok(())
-    })
+    })?)
 }
 
 /// Reads `dir/checkpoint.mpm`.

@@ -2,9 +2,13 @@
 
 use std::path::PathBuf;
 
+use mpm_output::OutputError;
+use mpm_scene::SceneError;
 use thiserror::Error;
 
-/// Everything that can go wrong while loading a scene or writing results.
+/// Everything that can go wrong while running a case or a scene with its
+/// outputs: the errors of the scene ([`SceneError`]) and of the result
+/// files ([`OutputError`]), and those of runs, checkpoints and defaults.
 ///
 /// Every variant names where the problem is: the file, the data array and
 /// index, the line and column of a scene file, or the command-line override,
@@ -42,117 +46,6 @@ pub enum CasesError {
         /// Why it is rejected.
         reason: &'static str,
     },
-    /// An output array holds NaN or infinity.
-    #[error("array `{array}` has the non-finite value {value} at index {index}")]
-    NonFinite {
-        /// The array (or CSV column) name.
-        array: String,
-        /// Index of the offending entry: the point, cell or row, not the
-        /// flattened component.
-        index: usize,
-        /// The value found.
-        value: f64,
-    },
-    /// A value to be serialised (e.g. into `summary.json`) is NaN or infinity.
-    #[error("field `{field}` has the non-finite value {value}")]
-    NonFiniteField {
-        /// Path of the field, e.g. `cases[2].error_l2`.
-        field: String,
-        /// The value found.
-        value: f64,
-    },
-    /// An array's length does not match the number of points, cells,
-    /// columns or components it belongs to.
-    #[error("array `{array}` has {found} entries, expected {expected}")]
-    LengthMismatch {
-        /// The array (or CSV row) name.
-        array: String,
-        /// The required length.
-        expected: usize,
-        /// The length given.
-        found: usize,
-    },
-    /// A data array declared with zero components per tuple.
-    #[error("array `{array}` has zero components per tuple")]
-    ZeroComponents {
-        /// The array name.
-        array: String,
-    },
-    /// Points of a dimension VTK cannot hold.
-    #[error("points of dimension {dim} cannot be written: VTK takes 1 to 3 coordinates")]
-    InvalidDimension {
-        /// The dimension given.
-        dim: usize,
-    },
-    /// A cell refers to a point that does not exist.
-    #[error("cell {cell} refers to point {node}, but there are only {n_points} points")]
-    NodeOutOfRange {
-        /// Index of the cell.
-        cell: usize,
-        /// The offending point index.
-        node: usize,
-        /// The number of points.
-        n_points: usize,
-    },
-    /// A cell's connectivity does not have the node count its type requires.
-    #[error("{cell_type} cells have {expected} nodes each, but {found} node indices were given")]
-    CellNodeCount {
-        /// The VTK cell type's name.
-        cell_type: &'static str,
-        /// Nodes per cell of this type.
-        expected: usize,
-        /// Length of the connectivity given.
-        found: usize,
-    },
-    /// An empty, duplicate or otherwise unusable name for an array or column.
-    #[error("{what} name `{name}`: {reason}")]
-    InvalidName {
-        /// What the name is for, e.g. `"point data array"`.
-        what: &'static str,
-        /// The name given.
-        name: String,
-        /// Why it is rejected.
-        reason: &'static str,
-    },
-    /// A time series must advance: each step's time finite and larger than
-    /// the previous one.
-    #[error("time {time} of a series must be finite and after the previous time {previous}")]
-    InvalidTime {
-        /// The time of the previous step (`-inf` if none).
-        previous: f64,
-        /// The time given.
-        time: f64,
-    },
-    /// `serde_json` could not serialise a value.
-    #[error("{}: cannot serialise to JSON: {source}", path.display())]
-    Json {
-        /// The file that was to be written.
-        path: PathBuf,
-        /// The serialiser's error.
-        source: serde_json::Error,
-    },
-    /// A scene file (or the scene after overrides) is invalid at a known
-    /// place.
-    #[error("{origin}:{line}:{column}: {message}")]
-    Scene {
-        /// The file name, or whatever the text came from.
-        origin: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column, in characters.
-        column: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A scene is invalid as a whole (e.g. a required key is missing and the
-    /// parser gave no position).
-    #[error("{origin}: {message}")]
-    SceneUnlocated {
-        /// The file name, or whatever the text came from.
-        origin: String,
-        /// What is wrong.
-        message: String,
-    },
     /// The solver failed, or stopped where it was asked to.
     #[error(transparent)]
     Solver(#[from] mpm_solver::SolverError),
@@ -162,21 +55,10 @@ pub enum CasesError {
         /// The serialiser's error.
         source: toml::ser::Error,
     },
-    /// A command-line override is not of the form `key=value`.
-    #[error("malformed override `{text}`: {reason} (expected key=value, e.g. material.E=1e6)")]
-    MalformedOverride {
-        /// The override as given.
-        text: String,
-        /// What is wrong with it.
-        reason: &'static str,
-    },
-    /// A well-formed override cannot be applied, or makes the scene invalid
-    /// (unknown key, wrong type).
-    #[error("override `{text}`: {message}")]
-    Override {
-        /// The override as given.
-        text: String,
-        /// What is wrong.
-        message: String,
-    },
+    /// A scene file, an override or the problem it describes is invalid.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A result file could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
 }

@@ -23,20 +23,18 @@
 //! # Ok::<(), mpm_solver::SolverError>(())
 //! ```
 
-pub mod body;
 pub mod cases;
 pub mod checkpoint;
 pub mod error;
 pub mod locking;
-pub mod manufactured;
-pub mod material;
-pub mod output;
 pub mod params;
-pub mod run;
 pub mod scene;
-pub mod scene_file;
 pub mod session;
-pub mod variant;
 pub mod writer;
+
+pub use mpm_dispatch::run;
+pub use mpm_output as output;
+pub use mpm_scene::source as scene_file;
+pub use mpm_scene::{body, manufactured, material, variant};
 
 pub use error::CasesError;

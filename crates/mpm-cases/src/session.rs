@@ -61,10 +61,11 @@ impl Session {
         p: &P,
         grid: M,
     ) -> Result<(Observer<D, M>, RunControl), CasesError> {
-        let parameters = serde_json::to_value(p).map_err(|source| CasesError::Json {
-            path: self.out.join(checkpoint::FILE_NAME),
-            source,
-        })?;
+        let parameters =
+            serde_json::to_value(p).map_err(|source| crate::output::OutputError::Json {
+                path: self.out.join(checkpoint::FILE_NAME),
+                source,
+            })?;
         let (writer, resume) = if self.resume {
             let (header, checkpoint) = checkpoint::read(&self.out)?;
             if header.case != self.case || header.parameters != parameters {

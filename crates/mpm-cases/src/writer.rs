@@ -17,6 +17,8 @@ use crate::output::{
 use crate::run::Snapshot;
 use crate::variant::Variant;
 
+pub use mpm_scene::format::Field;
+
 /// Output of one run in a directory, for material points in `D`
 /// dimensions on the background mesh `M`.
 #[derive(Debug)]
@@ -29,43 +31,6 @@ pub struct RunWriter<const D: usize, M> {
     iterations: CsvTable,
     tables: BTreeMap<String, CsvTable>,
     options: VtuOptions,
-}
-
-/// Fields of the material-point VTU files.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Field {
-    /// Total displacement (`displacement`).
-    Displacement,
-    /// Velocity (`velocity`; explicit runs).
-    Velocity,
-    /// Cauchy stress (`cauchy_stress`).
-    Stress,
-    /// Deformation gradient (`deformation_gradient`).
-    DeformationGradient,
-    /// Volume (`volume`).
-    Volume,
-    /// Equivalent plastic strain (`equivalent_plastic_strain`).
-    PlasticStrain,
-    /// GIMP/CPDI2 domain bounds (`domain_lower`, `domain_upper`).
-    Domain,
-    /// The per-point constants of [`VtuOptions::constants`] (e.g. a scene's
-    /// body and material indices).
-    Body,
-}
-
-impl Field {
-    /// Every field.
-    pub const ALL: [Field; 8] = [
-        Field::Displacement,
-        Field::Velocity,
-        Field::Stress,
-        Field::DeformationGradient,
-        Field::Volume,
-        Field::PlasticStrain,
-        Field::Domain,
-        Field::Body,
-    ];
 }
 
 /// What the VTU files of a run hold and how often they are written.
@@ -270,7 +235,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
             std::collections::btree_map::Entry::Vacant(e) => e.insert(CsvTable::new(header)?),
         };
         table.push_row(row)?;
-        table.write(&self.dir.join(file))
+        Ok(table.write(&self.dir.join(file))?)
     }
 
     /// The output directory.
@@ -332,7 +297,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
                 CsvValue::from(*r),
             ])?;
         }
-        self.iterations.write(&self.dir.join("iterations.csv"))
+        Ok(self.iterations.write(&self.dir.join("iterations.csv"))?)
     }
 
     /// Writes the VTU files (points and active grid) of output `index` of
@@ -391,7 +356,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
         }
         let grid_path = self.dir.join(format!("grid_{step:04}.vtu"));
         self.write_active_grid(&grid_path, snap)?;
-        self.cells.push(time, &grid_path)
+        Ok(self.cells.push(time, &grid_path)?)
     }
 
     /// The mesh cells holding material points.
@@ -400,12 +365,12 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
         let cells = self.grid.cells_holding(&snap.position);
         let mut vtu = UnstructuredGrid::new(&nodes)?;
         vtu.add_cells(M::CELL, &cells)?;
-        vtu.write(path)
+        Ok(vtu.write(path)?)
     }
 
     /// Writes `summary.json`.
     pub fn summary<P: Serialize>(&self, summary: &Summary<P>) -> Result<(), CasesError> {
-        write_summary(&self.dir.join("summary.json"), summary)
+        Ok(write_summary(&self.dir.join("summary.json"), summary)?)
     }
 
     /// Writes `summary.json` of an explicit run.
@@ -413,6 +378,6 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
         &self,
         summary: &ExplicitSummary<P>,
     ) -> Result<(), CasesError> {
-        write_summary(&self.dir.join("summary.json"), summary)
+        Ok(write_summary(&self.dir.join("summary.json"), summary)?)
     }
 }

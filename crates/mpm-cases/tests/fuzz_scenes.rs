@@ -78,6 +78,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use mpm_cases::CasesError;
+use mpm_cases::scene::SceneError;
 use mpm_cases::scene::{self, Problem};
 use mpm_cases::session::Session;
 use toml::{Table, Value};
@@ -722,7 +723,7 @@ fn mutant(
 const ORIGIN: &str = "mutant.toml";
 
 /// Parses and builds; `Ok(true)` for an explicit scene.
-fn build(text: &str, set: &[String], dir: &Path) -> Result<bool, CasesError> {
+fn build(text: &str, set: &[String], dir: &Path) -> Result<bool, SceneError> {
     let (scene, source) = scene::parse(text, ORIGIN, set)?;
     match scene::dimension(&scene, &source)? {
         2 => Problem::<2>::build_in(&scene, &source, scene.solver.padding(), dir)
@@ -804,11 +805,11 @@ fn kind_of(e: &CasesError) -> String {
             .to_owned()
     };
     match e {
-        CasesError::Scene { message, .. }
-        | CasesError::SceneUnlocated { message, .. }
-        | CasesError::Override { message, .. } => {
-            format!("{}: {}", head(&format!("{e:?}")), first_words(message, 4))
-        }
+        CasesError::Scene(
+            s @ (SceneError::Scene { message, .. }
+            | SceneError::SceneUnlocated { message, .. }
+            | SceneError::Override { message, .. }),
+        ) => format!("{}: {}", head(&format!("{s:?}")), first_words(message, 4)),
         CasesError::Solver(s) => format!(
             "Solver({}): {}",
             head(&format!("{s:?}")),
@@ -868,7 +869,7 @@ impl Tally {
     fn rejection(&mut self, e: &CasesError, text: &str, what: &str, dump: &dyn Fn() -> PathBuf) {
         count(&mut self.rejected, e);
         match e {
-            CasesError::Scene { line, column, .. } => {
+            CasesError::Scene(SceneError::Scene { line, column, .. }) => {
                 let lines = text.lines().count().max(1);
                 if *line == 0 || *column == 0 || *line > lines + 1 {
                     self.bad_locations.push(format!(
@@ -877,7 +878,9 @@ impl Tally {
                     ));
                 }
             }
-            CasesError::Override { .. } | CasesError::MalformedOverride { .. } => {}
+            CasesError::Scene(
+                SceneError::Override { .. } | SceneError::MalformedOverride { .. },
+            ) => {}
             other => {
                 let variant = kind_of(other);
                 let variant = variant.split(':').next().unwrap_or("").to_owned();
@@ -1037,7 +1040,7 @@ fn mutated_scenes_build_run_or_are_refused_with_a_typed_error() {
             let end_time = *end_time;
             Box::new(move || {
                 let t = Instant::now();
-                let built = build(&input, &set, &dir);
+                let built = build(&input, &set, &dir).map_err(CasesError::from);
                 let ran = match (&built, try_run) {
                     (Ok(explicit), true) => {
                         // An explicit run simulates a thousandth of the
@@ -1124,7 +1127,7 @@ fn a_simplex_box_with_too_many_elements_is_refused() {
     let e = build(&text, &["mesh.cells=[200, 200, 200]".into()], &dir)
         .expect_err("a mesh of 384 million elements");
     assert!(
-        matches!(&e, CasesError::Override { message, .. }
+        matches!(&e, SceneError::Override { message, .. }
             if message.contains("the mesh would have more than 50000000 elements")),
         "{e}"
     );
@@ -1144,7 +1147,7 @@ fn a_cfl_factor_of_more_than_1e9_steps_is_refused() {
     ] {
         let built = build(&text, &[format!("solver.cfl={cfl}")], &dir);
         match (&built, refused) {
-            (Err(CasesError::Override { message, .. }), true) => assert!(
+            (Err(SceneError::Override { message, .. }), true) => assert!(
                 message.contains("would take") && message.contains("more than 1e9"),
                 "{message}"
             ),

@@ -6,7 +6,7 @@ mod common;
 use std::path::Path;
 
 use common::{dir_entries, element, fresh_dir, parse_xml};
-use mpm_cases::CasesError;
+use mpm_cases::output::OutputError;
 use mpm_cases::output::{
     CsvTable, CsvValue, PvdSeries, atomic_write, atomic_write_with, write_summary,
 };
@@ -31,7 +31,7 @@ fn atomic_write_into_missing_directory_fails_and_creates_nothing() {
     let path = missing.join("a.txt");
     let err = atomic_write(&path, b"data").unwrap_err();
     match &err {
-        CasesError::Io { path: p, source } => {
+        OutputError::Io { path: p, source } => {
             assert_eq!(p, &path);
             assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
         }
@@ -72,7 +72,7 @@ fn failed_rename_leaves_target_and_no_temporary() {
     std::fs::write(target.join("keep"), b"x").unwrap();
     assert!(matches!(
         atomic_write(&target, b"data"),
-        Err(CasesError::Io { .. })
+        Err(OutputError::Io { .. })
     ));
     assert!(target.join("keep").exists());
     assert_eq!(dir_entries(&dir), vec!["out.vtu".to_owned()]);
@@ -82,7 +82,7 @@ fn failed_rename_leaves_target_and_no_temporary() {
 fn path_without_file_name_is_refused() {
     assert!(matches!(
         atomic_write(Path::new("/"), b"x"),
-        Err(CasesError::InvalidPath { .. })
+        Err(OutputError::InvalidPath { .. })
     ));
 }
 
@@ -141,7 +141,7 @@ fn pvd_refuses_times_that_do_not_advance() {
     for bad in [1.0, 0.5, f64::NAN, f64::INFINITY] {
         let err = series.push(bad, Path::new("b.vtu")).unwrap_err();
         assert!(
-            matches!(err, CasesError::InvalidTime { previous, .. } if previous == 1.0),
+            matches!(err, OutputError::InvalidTime { previous, .. } if previous == 1.0),
             "{err:?}"
         );
     }
@@ -155,7 +155,7 @@ fn pvd_step_is_dropped_when_the_write_fails() {
     let mut series = PvdSeries::new(dir.join("missing").join("s.pvd"));
     assert!(matches!(
         series.push(0.0, Path::new("a.vtu")),
-        Err(CasesError::Io { .. })
+        Err(OutputError::Io { .. })
     ));
     assert!(series.steps().is_empty(), "a failed push can be retried");
 }
@@ -204,7 +204,7 @@ fn csv_refuses_nan_naming_column_and_row() {
     t.push_row(&[0_usize.into(), 1.0.into()]).unwrap();
     let err = t.push_row(&[1_usize.into(), f64::NAN.into()]).unwrap_err();
     match &err {
-        CasesError::NonFinite {
+        OutputError::NonFinite {
             array,
             index,
             value,
@@ -223,20 +223,20 @@ fn csv_refuses_bad_shapes_and_names() {
     let mut t = CsvTable::new(&["a", "b"]).unwrap();
     let err = t.push_row(&[1.0.into()]).unwrap_err();
     assert!(
-        matches!(&err, CasesError::LengthMismatch { array, expected: 2, found: 1 } if array == "row 0"),
+        matches!(&err, OutputError::LengthMismatch { array, expected: 2, found: 1 } if array == "row 0"),
         "{err:?}"
     );
     let none: [&str; 0] = [];
     assert!(matches!(
         CsvTable::new(&none),
-        Err(CasesError::InvalidName { .. })
+        Err(OutputError::InvalidName { .. })
     ));
     assert!(matches!(
         CsvTable::new(&["a", ""]),
-        Err(CasesError::InvalidName { .. })
+        Err(OutputError::InvalidName { .. })
     ));
     assert!(
-        matches!(CsvTable::new(&["a", "a"]), Err(CasesError::InvalidName { name, .. }) if name == "a")
+        matches!(CsvTable::new(&["a", "a"]), Err(OutputError::InvalidName { name, .. }) if name == "a")
     );
 }
 
@@ -303,7 +303,7 @@ fn summary_with_nan_is_refused_and_old_file_kept() {
     bad.levels[1].error = f64::NAN;
     let err = write_summary(&path, &bad).unwrap_err();
     assert!(
-        matches!(&err, CasesError::NonFiniteField { field, .. } if field == "levels[1].error"),
+        matches!(&err, OutputError::NonFiniteField { field, .. } if field == "levels[1].error"),
         "{err:?}"
     );
     let mut bad = summary();

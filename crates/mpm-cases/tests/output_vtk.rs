@@ -5,7 +5,7 @@
 mod common;
 
 use common::{data_array, dir_entries, element, fresh_dir, parse_xml};
-use mpm_cases::CasesError;
+use mpm_cases::output::OutputError;
 use mpm_cases::output::vtk::{CellType, UnstructuredGrid, Values};
 
 fn as_f64(v: &[i64]) -> Vec<f64> {
@@ -169,7 +169,7 @@ fn non_finite_values_are_refused_with_array_and_index() {
 
     let p = [0.0, 1.0, f64::NAN];
     match grid.point_data("pressure", Values::scalars(&p)) {
-        Err(CasesError::NonFinite {
+        Err(OutputError::NonFinite {
             array,
             index,
             value,
@@ -185,7 +185,7 @@ fn non_finite_values_are_refused_with_array_and_index() {
         .point_data("velocity", Values::vectors(&v))
         .unwrap_err();
     assert!(
-        matches!(&err, CasesError::NonFinite { array, index: 1, value } if array == "velocity" && *value == f64::INFINITY),
+        matches!(&err, OutputError::NonFinite { array, index: 1, value } if array == "velocity" && *value == f64::INFINITY),
         "{err:?}"
     );
     assert_eq!(
@@ -196,14 +196,14 @@ fn non_finite_values_are_refused_with_array_and_index() {
     let bad_points = [[0.0, f64::NEG_INFINITY]];
     let err = UnstructuredGrid::from_points(&bad_points).unwrap_err();
     assert!(
-        matches!(&err, CasesError::NonFinite { array, index: 0, .. } if array == "Points"),
+        matches!(&err, OutputError::NonFinite { array, index: 0, .. } if array == "Points"),
         "{err:?}"
     );
 
     let c = [f64::NAN];
     let err = grid.cell_data("mass", Values::scalars(&c)).unwrap_err();
     assert!(
-        matches!(&err, CasesError::NonFinite { array, index: 0, .. } if array == "mass"),
+        matches!(&err, OutputError::NonFinite { array, index: 0, .. } if array == "mass"),
         "{err:?}"
     );
 
@@ -223,7 +223,7 @@ fn inconsistent_lengths_are_refused() {
     let short = [1.0, 2.0];
     let err = grid.point_data("p", Values::scalars(&short)).unwrap_err();
     assert!(
-        matches!(&err, CasesError::LengthMismatch { array, expected: 4, found: 2 } if array == "p"),
+        matches!(&err, OutputError::LengthMismatch { array, expected: 4, found: 2 } if array == "p"),
         "{err:?}"
     );
 
@@ -234,7 +234,7 @@ fn inconsistent_lengths_are_refused() {
     };
     let err = grid.point_data("v", ragged).unwrap_err();
     assert!(
-        matches!(&err, CasesError::LengthMismatch { found: 7, .. }),
+        matches!(&err, OutputError::LengthMismatch { found: 7, .. }),
         "{err:?}"
     );
 
@@ -243,7 +243,7 @@ fn inconsistent_lengths_are_refused() {
         .point_data("e", Values::components(&empty))
         .unwrap_err();
     assert!(
-        matches!(&err, CasesError::ZeroComponents { array } if array == "e"),
+        matches!(&err, OutputError::ZeroComponents { array } if array == "e"),
         "{err:?}"
     );
 
@@ -251,7 +251,7 @@ fn inconsistent_lengths_are_refused() {
     assert!(
         matches!(
             err,
-            CasesError::CellNodeCount {
+            OutputError::CellNodeCount {
                 cell_type: "VTK_QUAD",
                 expected: 4,
                 found: 3
@@ -266,7 +266,7 @@ fn inconsistent_lengths_are_refused() {
     assert!(
         matches!(
             err,
-            CasesError::NodeOutOfRange {
+            OutputError::NodeOutOfRange {
                 cell: 2,
                 node: 4,
                 n_points: 4
@@ -280,18 +280,18 @@ fn inconsistent_lengths_are_refused() {
     grid.point_data("p", Values::scalars(&p)).unwrap();
     let err = grid.point_data("p", Values::scalars(&p)).unwrap_err();
     assert!(
-        matches!(&err, CasesError::InvalidName { name, .. } if name == "p"),
+        matches!(&err, OutputError::InvalidName { name, .. } if name == "p"),
         "{err:?}"
     );
     let err = grid.point_data(" ", Values::scalars(&p)).unwrap_err();
-    assert!(matches!(&err, CasesError::InvalidName { .. }), "{err:?}");
+    assert!(matches!(&err, OutputError::InvalidName { .. }), "{err:?}");
 
     // Cell data are checked against the cells when the grid is written.
     let two = [1.0, 2.0];
     grid.cell_data("c", Values::scalars(&two)).unwrap();
     let err = grid.validate().unwrap_err();
     assert!(
-        matches!(&err, CasesError::LengthMismatch { array, expected: 1, found: 2 } if array == "c"),
+        matches!(&err, OutputError::LengthMismatch { array, expected: 1, found: 2 } if array == "c"),
         "{err:?}"
     );
     let dir = fresh_dir("vtk_length_mismatch");
@@ -305,7 +305,7 @@ fn inconsistent_lengths_are_refused() {
     let four_d = [[0.0; 4]];
     let err = UnstructuredGrid::from_points(&four_d).unwrap_err();
     assert!(
-        matches!(err, CasesError::InvalidDimension { dim: 4 }),
+        matches!(err, OutputError::InvalidDimension { dim: 4 }),
         "{err:?}"
     );
     assert!(Values::vectors_padded(&[[0.0; 0]]).is_err());

@@ -5,7 +5,7 @@
 mod common;
 
 use common::fresh_dir;
-use mpm_cases::CasesError;
+use mpm_cases::scene::SceneError;
 use mpm_cases::scene_file::{load_scene, parse_scene};
 use serde::Deserialize;
 
@@ -57,14 +57,14 @@ fn ov(list: &[&str]) -> Vec<String> {
     list.iter().map(|s| (*s).to_owned()).collect()
 }
 
-fn parse(text: &str, overrides: &[&str]) -> Result<Scene, CasesError> {
+fn parse(text: &str, overrides: &[&str]) -> Result<Scene, SceneError> {
     parse_scene(text, "scene.toml", &ov(overrides))
 }
 
 /// The (line, column, message) of a located scene error.
-fn located(err: &CasesError) -> (usize, usize, &str) {
+fn located(err: &SceneError) -> (usize, usize, &str) {
     match err {
-        CasesError::Scene {
+        SceneError::Scene {
             origin,
             line,
             column,
@@ -78,9 +78,9 @@ fn located(err: &CasesError) -> (usize, usize, &str) {
 }
 
 /// The (override, message) of an override error.
-fn from_override(err: &CasesError) -> (&str, &str) {
+fn from_override(err: &SceneError) -> (&str, &str) {
     match err {
-        CasesError::Override { text, message } => (text.as_str(), message.as_str()),
+        SceneError::Override { text, message } => (text.as_str(), message.as_str()),
         other => panic!("expected an override error, got {other:?}"),
     }
 }
@@ -167,7 +167,7 @@ fn missing_key_is_reported_and_an_override_can_supply_it() {
     let text = SCENE.replace("h = 0.5\n", "");
     let err = parse(&text, &[]).unwrap_err();
     assert_eq!(err.to_string(), "scene.toml: missing field `h`");
-    assert!(matches!(err, CasesError::SceneUnlocated { .. }), "{err:?}");
+    assert!(matches!(err, SceneError::SceneUnlocated { .. }), "{err:?}");
     // A key missing from a table is located at the table's header.
     let err = parse(&SCENE.replace("nu = 0.3\n", ""), &[]).unwrap_err();
     let (line, column, message) = located(&err);
@@ -268,7 +268,7 @@ fn malformed_overrides_are_their_own_error() {
         ("h=", "empty value"),
     ] {
         match parse(SCENE, &[bad]) {
-            Err(CasesError::MalformedOverride { text, reason: r }) => {
+            Err(SceneError::MalformedOverride { text, reason: r }) => {
                 assert_eq!(text, bad);
                 assert!(r.starts_with(reason), "{bad}: {r}");
             }
@@ -318,6 +318,6 @@ fn load_scene_reads_a_file_and_names_it_in_errors() {
     let missing = dir.join("missing.toml");
     assert!(matches!(
         load_scene::<Scene>(&missing, &[]),
-        Err(CasesError::Io { path, .. }) if path == missing
+        Err(SceneError::Io { path, .. }) if path == missing
     ));
 }

@@ -5,8 +5,8 @@
 
 mod common;
 
-use mpm_cases::CasesError;
 use mpm_cases::run::{RunControl, RunOutput};
+use mpm_cases::scene::SceneError;
 use mpm_cases::scene::build::SceneMesh as SceneMeshKind;
 use mpm_cases::scene::{self, Problem};
 use proptest::prelude::*;
@@ -765,7 +765,7 @@ fn missing_sections_and_bad_overrides_are_named() {
     }
     let e = scene::parse(VALID, "v.toml", &["solver.stepz=3".into()]).unwrap_err();
     assert!(
-        matches!(&e, CasesError::Override { text, message } if text == "solver.stepz=3" && message.contains("unknown field `stepz`")),
+        matches!(&e, SceneError::Override { text, message } if text == "solver.stepz=3" && message.contains("unknown field `stepz`")),
         "{e}"
     );
 }

@@ -118,8 +118,9 @@ pub(crate) fn build_scene<const D: usize>(
     case: &str,
     padding: usize,
 ) -> Result<crate::scene::Problem<D>, mpm_solver::SolverError> {
-    let invalid =
-        |e: CasesError| mpm_solver::SolverError::InvalidInput(format!("case {case}: {e}"));
+    let invalid = |e: mpm_scene::SceneError| {
+        mpm_solver::SolverError::InvalidInput(format!("case {case}: {e}"))
+    };
     let (scene, src) =
         crate::scene::parse(text, &format!("the {case} case's scene"), &[]).map_err(invalid)?;
     crate::scene::Problem::<D>::build_in(&scene, &src, padding, std::path::Path::new(""))

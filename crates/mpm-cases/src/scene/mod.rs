@@ -1,4 +1,5 @@
-//! Scenes as data: a whole problem — mesh, materials, bodies, node sets,
+//! Scenes as data (the `mpm-scene` crate, run by `mpm-dispatch`, written
+//! by this crate's program): a whole problem — mesh, materials, bodies, node sets,
 //! boundary conditions, loads with load curves, solver and outputs — in
 //! one TOML file, run without writing Rust.
 //!
@@ -56,70 +57,17 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub mod build;
-pub mod explicit;
-pub mod explicit_law;
-pub mod format;
-pub mod png;
+pub use mpm_dispatch::{explicit, explicit_law};
+pub use mpm_output::png;
+pub use mpm_scene::{SceneError, build, format, region};
 mod program;
-pub mod region;
-mod runner;
 
-pub use build::{
-    ExplicitSetup, Problem, ReactionOutput, SceneConstraints, SceneMotion, TimedForces,
+pub use mpm_dispatch::{
+    ExplicitEvent, ExplicitFrame, ExplicitObserver, ExplicitOutput, RunExplicit, RunScene, run,
+    run_explicit,
 };
-pub use explicit::{
-    ExplicitEvent, ExplicitFrame, ExplicitObserver, ExplicitOutput, RunExplicit, run_explicit,
+pub use mpm_scene::{
+    ExplicitSetup, Problem, ReactionOutput, Scene, SceneConstraints, SceneMotion, TimedForces,
+    dimension, parse,
 };
-pub use format::Scene;
 pub use program::run_file;
-pub use runner::{RunScene, run};
-
-use crate::CasesError;
-use crate::scene_file::{SceneSource, parse_scene_located};
-
-/// Parses scene `text` (named `origin` in errors) with `--set` overrides.
-///
-/// # Errors
-/// As [`crate::scene_file::parse_scene`].
-pub fn parse(
-    text: &str,
-    origin: &str,
-    overrides: &[String],
-) -> Result<(Scene, SceneSource), CasesError> {
-    parse_scene_located(text, origin, overrides)
-}
-
-/// The dimension of a scene: the length of its grid (or simplex box)
-/// origin, or the
-/// `dimension` of its Gmsh mesh, if 2 or 3.
-///
-/// # Errors
-/// [`CasesError::Scene`] at the origin or dimension otherwise,
-/// [`CasesError::SceneUnlocated`] when the mesh gives neither.
-pub fn dimension(scene: &Scene, source: &SceneSource) -> Result<usize, CasesError> {
-    let m = &scene.mesh;
-    let (d, at) = match (m.kind, &m.origin, &m.dimension) {
-        (format::MeshKind::Annulus, _, _) => return Ok(2),
-        (format::MeshKind::Grid | format::MeshKind::Simplex, Some(origin), _) => {
-            (origin.get_ref().len(), origin.span())
-        }
-        (format::MeshKind::Gmsh, _, Some(d)) => (*d.get_ref(), d.span()),
-        (format::MeshKind::Grid | format::MeshKind::Simplex, None, _) => {
-            return Err(source.error(
-                None,
-                "[mesh]: a grid or simplex box needs `origin`, `size` and `cells` or `spacing`",
-            ));
-        }
-        (format::MeshKind::Gmsh, _, None) => {
-            return Err(source.error(None, "[mesh]: a Gmsh mesh needs `file` and `dimension`"));
-        }
-    };
-    match d {
-        2 | 3 => Ok(d),
-        _ => Err(source.error(
-            Some(at),
-            &format!("the mesh has dimension {d}; scenes are 2D or 3D"),
-        )),
-    }
-}

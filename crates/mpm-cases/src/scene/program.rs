@@ -44,18 +44,18 @@ where
     }
     if problem.explicit.is_some() {
         if session.export_tangent {
-            return Err(source.error(
+            return Err(CasesError::from(source.error(
                 None,
                 "--export-tangent writes the implicit solver's stiffness; an explicit run assembles none",
-            ));
+            )));
         }
         return match &problem.mesh {
             crate::scene::build::SceneMesh::Grid(g) => {
                 explicit_run_on(scene, &problem, session, g.clone())
             }
-            crate::scene::build::SceneMesh::Simplex(_) => {
-                Err(source.error(None, "the explicit solver runs on regular grids"))
-            }
+            crate::scene::build::SceneMesh::Simplex(_) => Err(source
+                .error(None, "the explicit solver runs on regular grids")
+                .into()),
         };
     }
     match &problem.mesh {

@@ -7,8 +7,8 @@
 use std::io;
 use std::path::Path;
 
-use crate::CasesError;
-use crate::output::atomic_write_with;
+use crate::OutputError;
+use crate::atomic_write_with;
 
 /// Largest side of the picture in pixels.
 const SIZE: u32 = 800;
@@ -18,17 +18,17 @@ const SIZE: u32 = 800;
 /// that range.
 ///
 /// # Errors
-/// [`CasesError::Io`] when the file cannot be written,
-/// [`CasesError::LengthMismatch`] for arrays of different lengths.
+/// [`OutputError::Io`] when the file cannot be written,
+/// [`OutputError::LengthMismatch`] for arrays of different lengths.
 pub fn write_points_png(
     path: &Path,
     position: &[[f64; 3]],
     half: &[f64],
     value: &[f64],
-) -> Result<(f64, f64), CasesError> {
+) -> Result<(f64, f64), OutputError> {
     for (array, len) in [("half sizes", half.len()), ("values", value.len())] {
         if len != position.len() {
-            return Err(CasesError::LengthMismatch {
+            return Err(OutputError::LengthMismatch {
                 array: array.into(),
                 expected: position.len(),
                 found: len,
@@ -50,7 +50,7 @@ pub fn write_points_png(
         });
     let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
     if position.is_empty() || !(extent.is_finite() && extent > 0.0) {
-        return Err(CasesError::LengthMismatch {
+        return Err(OutputError::LengthMismatch {
             array: "positions (a picture needs points with a non-zero extent)".into(),
             expected: 1,
             found: 0,

@@ -1,6 +1,6 @@
 //! Material point bodies filling rectangular (box) regions of a grid.
 
-use mpm_basis::BasisFunction;
+use mpm_basis::{BasisFunction, Corners};
 use mpm_mesh::{RegularGrid, SimplexMesh};
 use nalgebra::SVector;
 
@@ -216,6 +216,35 @@ fn subdivision_centroids<const D: usize>(n: usize) -> Vec<([f64; 4], f64)> {
 pub trait InitialDomain<const D: usize>: BasisFunction<D> {}
 
 impl<const D: usize, B: BasisFunction<D>> InitialDomain<D> for B {}
+
+/// The box a material point's domain covers, for output and for measuring
+/// a body by its domains (Coombs 2020 Table 7).
+pub trait DomainBounds<const D: usize> {
+    /// Lower and upper corners of the domain's bounding box, or `None` for
+    /// bases without a domain.
+    fn bounds(&self, position: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)>;
+}
+
+impl<const D: usize> DomainBounds<D> for () {
+    fn bounds(&self, _: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+        None
+    }
+}
+
+/// GIMP: the box $\mathbf x_p \pm \mathbf l_p$.
+impl<const D: usize> DomainBounds<D> for SVector<f64, D> {
+    fn bounds(&self, position: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+        Some((position - self, position + self))
+    }
+}
+
+/// CPDI2: the bounding box of the corners.
+impl<const D: usize> DomainBounds<D> for Corners<D> {
+    fn bounds(&self, _: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+        let b = self.bounding_box();
+        Some((b.lower, b.upper))
+    }
+}
 
 #[cfg(test)]
 mod tests {

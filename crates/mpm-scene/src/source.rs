@@ -3,7 +3,7 @@
 //!
 //! ```
 //! use serde::Deserialize;
-//! use mpm_cases::scene_file::parse_scene;
+//! use mpm_scene::source::parse_scene;
 //!
 //! #[derive(Deserialize)]
 //! #[serde(deny_unknown_fields)]
@@ -18,7 +18,7 @@
 //! let scene: Scene = parse_scene(text, "scene.toml", &overrides)?;
 //! assert_eq!(scene.material.e, 2e6);
 //! assert_eq!(scene.basis, "gimp");
-//! # Ok::<(), mpm_cases::CasesError>(())
+//! # Ok::<(), mpm_scene::SceneError>(())
 //! ```
 //!
 //! # Overrides
@@ -47,7 +47,7 @@ use serde::de::DeserializeOwned;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
-use crate::CasesError;
+use crate::SceneError;
 
 /// Reads the TOML scene at `path`, applies `overrides` and deserialises the
 /// result into `T`.
@@ -55,10 +55,10 @@ use crate::CasesError;
 /// Errors name the file by `path` as given.
 ///
 /// # Errors
-/// [`CasesError::Io`] if the file cannot be read; otherwise as
+/// [`SceneError::Io`] if the file cannot be read; otherwise as
 /// [`parse_scene`].
-pub fn load_scene<T: DeserializeOwned>(path: &Path, overrides: &[String]) -> Result<T, CasesError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CasesError::Io {
+pub fn load_scene<T: DeserializeOwned>(path: &Path, overrides: &[String]) -> Result<T, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -70,17 +70,17 @@ pub fn load_scene<T: DeserializeOwned>(path: &Path, overrides: &[String]) -> Res
 /// messages.
 ///
 /// # Errors
-/// [`CasesError::MalformedOverride`] for an override without `=`, with an
-/// empty key, key segment or value; [`CasesError::Scene`] for malformed TOML,
+/// [`SceneError::MalformedOverride`] for an override without `=`, with an
+/// empty key, key segment or value; [`SceneError::Scene`] for malformed TOML,
 /// an unknown key, a wrong type or a non-finite float in `text`, with line
-/// and column; [`CasesError::Override`] when an override cannot be applied
+/// and column; [`SceneError::Override`] when an override cannot be applied
 /// (its path crosses a non-table value) or is what makes the scene invalid;
-/// [`CasesError::SceneUnlocated`] if the deserialiser gives no position.
+/// [`SceneError::SceneUnlocated`] if the deserialiser gives no position.
 pub fn parse_scene<T: DeserializeOwned>(
     text: &str,
     origin: &str,
     overrides: &[String],
-) -> Result<T, CasesError> {
+) -> Result<T, SceneError> {
     parse_scene_located(text, origin, overrides).map(|(scene, _)| scene)
 }
 
@@ -95,7 +95,7 @@ pub fn parse_scene_located<T: DeserializeOwned>(
     text: &str,
     origin: &str,
     overrides: &[String],
-) -> Result<(T, SceneSource), CasesError> {
+) -> Result<(T, SceneSource), SceneError> {
     let parsed: Vec<Override<'_>> = overrides
         .iter()
         .map(|o| Override::parse(o))
@@ -127,8 +127,8 @@ struct Override<'a> {
 }
 
 impl<'a> Override<'a> {
-    fn parse(text: &'a str) -> Result<Self, CasesError> {
-        let malformed = |reason| CasesError::MalformedOverride {
+    fn parse(text: &'a str) -> Result<Self, SceneError> {
+        let malformed = |reason| SceneError::MalformedOverride {
             text: text.to_owned(),
             reason,
         };
@@ -151,8 +151,8 @@ impl<'a> Override<'a> {
         Ok(Self { text, keys, value })
     }
 
-    fn error(&self, message: impl Into<String>) -> CasesError {
-        CasesError::Override {
+    fn error(&self, message: impl Into<String>) -> SceneError {
+        SceneError::Override {
             text: self.text.to_owned(),
             message: message.into(),
         }
@@ -161,7 +161,7 @@ impl<'a> Override<'a> {
     /// The override's value: TOML if it parses as a TOML value, else a
     /// string; every span set to `span`, so that deserialisation errors in
     /// it are traced back to this override.
-    fn value(&self, span: &Range<usize>) -> Result<Spanned<DeValue<'a>>, CasesError> {
+    fn value(&self, span: &Range<usize>) -> Result<Spanned<DeValue<'a>>, SceneError> {
         let value = match DeValue::parse(self.value) {
             Ok(v) => v,
             Err(_) => Spanned::new(0..0, DeValue::String(Cow::Borrowed(self.value))),
@@ -173,7 +173,7 @@ impl<'a> Override<'a> {
     }
 
     /// Inserts the value into `root` at the override's key path.
-    fn apply(&self, root: &mut DeTable<'a>, span: Range<usize>) -> Result<(), CasesError> {
+    fn apply(&self, root: &mut DeTable<'a>, span: Range<usize>) -> Result<(), SceneError> {
         let value = self.value(&span)?;
         let (last, parents) = self
             .keys
@@ -333,10 +333,10 @@ impl SceneSource {
     /// An error at `span` of the parsed document: `origin:line:column:
     /// message` in the file, or naming the override the span belongs to;
     /// without a span, the origin only.
-    pub fn error(&self, span: Option<Range<usize>>, message: &str) -> CasesError {
+    pub fn error(&self, span: Option<Range<usize>>, message: &str) -> SceneError {
         let message = message.trim_end().to_owned();
         let Some(span) = span else {
-            return CasesError::SceneUnlocated {
+            return SceneError::SceneUnlocated {
                 origin: self.origin.clone(),
                 message,
             };
@@ -347,14 +347,14 @@ impl SceneSource {
                 .partition_point(|&s| s <= span.start)
                 .saturating_sub(1);
             if let Some(o) = self.overrides.get(k) {
-                return CasesError::Override {
+                return SceneError::Override {
                     text: o.clone(),
                     message,
                 };
             }
         }
         let (line, column) = line_column(&self.text, span.start);
-        CasesError::Scene {
+        SceneError::Scene {
             origin: self.origin.clone(),
             line,
             column,
@@ -363,11 +363,11 @@ impl SceneSource {
     }
 
     /// [`Self::error`] at the place of `value`.
-    pub fn at<T>(&self, value: &Spanned<T>, message: impl AsRef<str>) -> CasesError {
+    pub fn at<T>(&self, value: &Spanned<T>, message: impl AsRef<str>) -> SceneError {
         self.error(Some(value.span()), message.as_ref())
     }
 
-    fn non_finite(&self, span: Range<usize>) -> CasesError {
+    fn non_finite(&self, span: Range<usize>) -> SceneError {
         let literal = self.text.get(span.clone()).unwrap_or("").trim();
         self.error(
             Some(span),

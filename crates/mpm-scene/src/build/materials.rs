@@ -4,22 +4,22 @@
 use std::collections::BTreeMap;
 
 use super::{BuiltMaterial, unique_names};
-use crate::CasesError;
+use crate::SceneError;
+use crate::format::MaterialSpec;
 use crate::material::{MaterialModel, MaterialParams, SceneLaw};
-use crate::scene::format::MaterialSpec;
-use crate::scene_file::SceneSource;
+use crate::source::SceneSource;
 
 /// The materials' names (for the bodies' lookups) and the built
 /// materials, in file order; `explicit`: the scene runs the explicit
 /// solver (which needs a positive density).
 ///
 /// # Errors
-/// [`CasesError::Scene`] at the material whose key is wrong.
+/// [`SceneError::Scene`] at the material whose key is wrong.
 pub(super) fn materials(
     specs: &[MaterialSpec],
     explicit: bool,
     src: &SceneSource,
-) -> Result<(BTreeMap<String, usize>, Vec<BuiltMaterial>), CasesError> {
+) -> Result<(BTreeMap<String, usize>, Vec<BuiltMaterial>), SceneError> {
     let material_names = unique_names(specs.iter().map(|m| &m.name), "material", src)?;
     if specs.is_empty() {
         return Err(src.error(None, "a scene needs at least one [[material]]"));

@@ -5,10 +5,10 @@ use nalgebra::SVector;
 use toml::Spanned;
 
 use super::{Check, ReactionOutput, unique_names};
-use crate::CasesError;
-use crate::scene::format::{Field, OutputSpec, SolverSpec};
-use crate::scene::region::point;
-use crate::scene_file::SceneSource;
+use crate::SceneError;
+use crate::format::{Field, OutputSpec, SolverSpec};
+use crate::region::point;
+use crate::source::SceneSource;
 
 /// The outputs' step interval, reactions, probes and fields.
 type Outputs<const D: usize> = (
@@ -19,21 +19,21 @@ type Outputs<const D: usize> = (
 );
 
 /// Finds a node set by name (or says why the name cannot be used).
-type SetOf<'s> = dyn Fn(&Spanned<String>) -> Result<&'s Vec<usize>, CasesError> + 's;
+type SetOf<'s> = dyn Fn(&Spanned<String>) -> Result<&'s Vec<usize>, SceneError> + 's;
 
 /// The outputs of `o`; `explicit`: the scene runs the explicit solver;
 /// `set_of` finds a node set by name, `nearest` the point nearest a
 /// position.
 ///
 /// # Errors
-/// [`CasesError::Scene`] at the key whose value is wrong or does not apply.
+/// [`SceneError::Scene`] at the key whose value is wrong or does not apply.
 pub(super) fn outputs<'s, const D: usize>(
     o: &OutputSpec,
     explicit: bool,
     src: &SceneSource,
     set_of: &SetOf<'s>,
     nearest: &dyn Fn(&SVector<f64, D>) -> usize,
-) -> Result<Outputs<D>, CasesError> {
+) -> Result<Outputs<D>, SceneError> {
     let check = Check { src };
     let every = check.at_least(&o.every, 1, "output `every`")?;
     if explicit {
@@ -50,7 +50,7 @@ pub(super) fn outputs<'s, const D: usize>(
             ));
         }
     }
-    let safe = |name: &Spanned<String>| -> Result<String, CasesError> {
+    let safe = |name: &Spanned<String>| -> Result<String, SceneError> {
         let v = name.get_ref();
         // 200 bytes leave room for the suffixes within the 255 of a
         // file name on common file systems.
@@ -82,7 +82,7 @@ pub(super) fn outputs<'s, const D: usize>(
                 },
             })
         })
-        .collect::<Result<Vec<_>, CasesError>>()?;
+        .collect::<Result<Vec<_>, SceneError>>()?;
     let probes = o
         .probes
         .iter()
@@ -92,7 +92,7 @@ pub(super) fn outputs<'s, const D: usize>(
                 nearest(&point::<D>(&p.at, "probe `at`", src)?),
             ))
         })
-        .collect::<Result<Vec<_>, CasesError>>()?;
+        .collect::<Result<Vec<_>, SceneError>>()?;
     if o.png && D != 2 {
         return Err(src.error(None, "output `png` draws 2D scenes only"));
     }

@@ -4,7 +4,7 @@
 use std::borrow::Cow;
 use std::fmt::Write as _;
 
-use crate::CasesError;
+use crate::OutputError;
 
 /// Appends `x` to `out` in the shortest form that parses back to the same
 /// `f64`: plain decimals for moderate magnitudes, exponent form otherwise
@@ -50,10 +50,10 @@ pub(crate) fn xml_escape(s: &str) -> Cow<'_, str> {
 
 /// Fails on the first non-finite entry of `data`, a flattened array of
 /// `components` values per tuple, naming the array and the tuple index.
-pub(crate) fn check_finite(name: &str, data: &[f64], components: usize) -> Result<(), CasesError> {
+pub(crate) fn check_finite(name: &str, data: &[f64], components: usize) -> Result<(), OutputError> {
     match data.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
-        Some(i) => Err(CasesError::NonFinite {
+        Some(i) => Err(OutputError::NonFinite {
             array: name.to_owned(),
             index: i / components.max(1),
             value: data[i],
@@ -106,7 +106,7 @@ mod tests {
     fn non_finite_reports_tuple_index() {
         let data = [0.0, 1.0, 2.0, 3.0, f64::NAN, 5.0];
         match check_finite("v", &data, 3) {
-            Err(CasesError::NonFinite {
+            Err(OutputError::NonFinite {
                 array,
                 index,
                 value,

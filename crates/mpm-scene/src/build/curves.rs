@@ -4,19 +4,19 @@
 use std::collections::BTreeMap;
 
 use super::{Curve, unique_names};
-use crate::CasesError;
-use crate::scene::format::CurveSpec;
-use crate::scene_file::SceneSource;
+use crate::SceneError;
+use crate::format::CurveSpec;
+use crate::source::SceneSource;
 
 /// The curves' names (for the loads' lookups; a name's index is its
 /// curve's minus one) and the curves, the default ramp first.
 ///
 /// # Errors
-/// [`CasesError::Scene`] at the curve whose rows are wrong.
+/// [`SceneError::Scene`] at the curve whose rows are wrong.
 pub(super) fn curves(
     specs: &[CurveSpec],
     src: &SceneSource,
-) -> Result<(BTreeMap<String, usize>, Vec<Curve>), CasesError> {
+) -> Result<(BTreeMap<String, usize>, Vec<Curve>), SceneError> {
     let curve_names = unique_names(specs.iter().map(|c| &c.name), "curve", src)?;
     let mut curves = vec![Curve::ramp()];
     for c in specs {

@@ -10,7 +10,7 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::CasesError;
+use crate::OutputError;
 
 /// Distinguishes temporary files of concurrent writes within one process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
@@ -26,9 +26,9 @@ const MAX_ATTEMPTS: u32 = 16;
 /// (or stays absent).
 ///
 /// # Errors
-/// [`CasesError::InvalidPath`] if `path` has no file name;
-/// [`CasesError::Io`] if the directory does not exist or any step fails.
-pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), CasesError> {
+/// [`OutputError::InvalidPath`] if `path` has no file name;
+/// [`OutputError::Io`] if the directory does not exist or any step fails.
+pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     atomic_write_with(path, |w| w.write_all(bytes))
 }
 
@@ -41,17 +41,17 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), CasesError> {
 ///
 /// # Errors
 /// As [`atomic_write`], plus whatever `write` returns, reported as
-/// [`CasesError::Io`] on `path`.
-pub fn atomic_write_with<F>(path: &Path, write: F) -> Result<(), CasesError>
+/// [`OutputError::Io`] on `path`.
+pub fn atomic_write_with<F>(path: &Path, write: F) -> Result<(), OutputError>
 where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
-    let io_err = |source| CasesError::Io {
+    let io_err = |source| OutputError::Io {
         path: path.to_path_buf(),
         source,
     };
     let Some(name) = path.file_name() else {
-        return Err(CasesError::InvalidPath {
+        return Err(OutputError::InvalidPath {
             path: path.to_path_buf(),
             reason: "has no file name to write to",
         });
@@ -99,10 +99,10 @@ fn create_temporary(dir: &Path, name: &str) -> io::Result<(PathBuf, File)> {
 /// therefore not share an output directory.
 ///
 /// # Errors
-/// [`CasesError::Io`] if `dir` cannot be read or a temporary file cannot
+/// [`OutputError::Io`] if `dir` cannot be read or a temporary file cannot
 /// be removed.
-pub fn remove_temporaries(dir: &Path) -> Result<usize, CasesError> {
-    let io_err = |path: PathBuf| move |source| CasesError::Io { path, source };
+pub fn remove_temporaries(dir: &Path) -> Result<usize, OutputError> {
+    let io_err = |path: PathBuf| move |source| OutputError::Io { path, source };
     let mut removed = 0;
     for entry in fs::read_dir(dir).map_err(io_err(dir.to_path_buf()))? {
         let entry = entry.map_err(io_err(dir.to_path_buf()))?;

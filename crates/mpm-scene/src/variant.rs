@@ -15,8 +15,8 @@ use mpm_solver::{
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
+use crate::body::DomainBounds;
 use crate::body::InitialDomain;
-use crate::run::DomainBounds;
 
 macro_rules! named_enum {
     ($(#[$doc:meta])* $name:ident { $($(#[$vdoc:meta])* $variant:ident => $text:literal),+ $(,)? }) => {
@@ -157,12 +157,7 @@ impl DomainUpdateKind {
             Self::Midpoint => GimpRule::Midpoint,
             Self::VolumeCorrectedDiagF => GimpRule::VolumeCorrectedDiagF,
             Self::IncrementalVolumeCorrectedDiagF => GimpRule::IncrementalVolumeCorrectedDiagF,
-            Self::Cpdi2 => {
-                return Err(
-                    "domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2"
-                        .into(),
-                );
-            }
+            Self::Cpdi2 => return Err(crate::rules::CPDI2_UPDATE_WITH_GIMP.into()),
         })
     }
 }
@@ -227,8 +222,7 @@ impl TransferKind {
     }
 }
 
-/// Why the implicit solver refuses `locking = cell_averaged`.
-pub const CELL_AVERAGED_IMPLICIT: &str = "locking = cell_averaged is the explicit solver's dilatation averaging (solver kind = \"explicit\"); the implicit solver takes fbar (grids) or fpatch (simplex patches)";
+pub use crate::rules::CELL_AVERAGED_IMPLICIT;
 
 /// A complete MPM variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -251,37 +245,6 @@ fn default_gimp_volume() -> GimpVolumeKind {
 }
 
 impl Variant {
-    /// `Ok` for the variants of simplex meshes: linear basis, no domain
-    /// update, and no locking treatment or F-patch when the mesh has
-    /// patches (`patches`: split from quadratic parents); `mesh` names the
-    /// mesh in the error.
-    pub fn require_simplex(&self, mesh: &str, patches: bool) -> Result<(), String> {
-        if self.basis != BasisKind::Linear || self.domain_update != DomainUpdateKind::None {
-            return Err(format!(
-                "on {mesh} the variant is standard MPM: basis = linear, domain_update = none (got {} / {})",
-                self.basis, self.domain_update
-            ));
-        }
-        match self.locking {
-            LockingKind::None => Ok(()),
-            LockingKind::FPatch if patches => Ok(()),
-            LockingKind::FPatch => Err(format!(
-                "locking = fpatch needs patches, and {mesh} has none: split quadratic parents with [mesh] patches = true, or read a quadratic (tri6/tet10) Gmsh mesh"
-            )),
-            LockingKind::FBar => Err(format!(
-                "locking = fbar averages over grid cells and applies to regular grids; on {mesh} use locking = fpatch"
-            )),
-            LockingKind::CellAveraged => Err(CELL_AVERAGED_IMPLICIT.into()),
-        }
-    }
-
-    /// `Ok` for standard MPM without domain update or locking treatment,
-    /// the only variant of the annulus and stretch cases' triangles and
-    /// tetrahedra without patches.
-    pub fn require_standard_mpm(&self, mesh: &str) -> Result<(), String> {
-        self.require_simplex(mesh, false)
-    }
-
     /// ` domain-volume` when GIMP points integrate with their domain's
     /// volume, else nothing (for one-line summaries).
     pub fn gimp_volume_note(&self) -> &'static str {
@@ -336,29 +299,9 @@ pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
     variant: &Variant,
     visitor: V,
 ) -> Result<V::Output, String> {
-    if variant.basis != BasisKind::Gimp && variant.gimp_volume != GimpVolumeKind::DetF {
-        return Err(format!(
-            "gimp_volume = {} applies to basis = gimp",
-            variant.gimp_volume
-        ));
-    }
-    match variant.locking {
-        LockingKind::None => {}
-        LockingKind::CellAveraged => return Err(CELL_AVERAGED_IMPLICIT.into()),
-        LockingKind::FPatch => {
-            return Err("locking = fpatch averages over the patches of split tri6/tet10 parents and applies to simplex meshes; on a regular grid use locking = fbar".into());
-        }
-        LockingKind::FBar => {
-            if variant.basis == BasisKind::Cpdi2
-                || !matches!(variant.domain_update, DomainUpdateKind::None)
-            {
-                return Err(format!(
-                    "scenes run locking = fbar with basis = linear, bspline2 or gimp and domain_update = none (got {} / {}); other combinations compose in Rust (mpm_solver::FBar)",
-                    variant.basis, variant.domain_update
-                ));
-            }
-        }
-    }
+    variant
+        .check(crate::rules::Context::ImplicitGrid)
+        .map_err(|refusal| refusal.message)?;
     dispatch_basis(variant, visitor)
 }
 
@@ -386,12 +329,11 @@ where
     V: VariantVisitor<D>,
     B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>,
 {
-    if variant.domain_update != DomainUpdateKind::None {
-        return Err(format!(
-            "domain_update = {} needs basis = gimp ({} has no domain to update)",
-            variant.domain_update, variant.basis
-        ));
-    }
+    debug_assert_eq!(
+        variant.domain_update,
+        DomainUpdateKind::None,
+        "checked by the rules"
+    );
     Ok(with_formulation(variant, visitor, basis, NoUpdate))
 }
 
@@ -402,14 +344,8 @@ where
     B: InitialDomain<D, Mesh = RegularGrid<D>, Domain = mpm_basis::Corners<D>>,
     B::Domain: Flat + DomainBounds<D>,
 {
-    match variant.domain_update {
-        DomainUpdateKind::None | DomainUpdateKind::Cpdi2 => {
-            Ok(with_formulation(variant, visitor, basis, ConvectedCorners))
-        }
-        other => Err(format!(
-            "basis = cpdi2 convects its corners with the grid; domain_update = {other} applies to gimp only"
-        )),
-    }
+    // The rules let `none` and `cpdi2` through; both convect the corners.
+    Ok(with_formulation(variant, visitor, basis, ConvectedCorners))
 }
 
 /// GIMP with every domain rule of Coombs et al. 2020 §6.4 and either

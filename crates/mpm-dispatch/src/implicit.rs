@@ -18,14 +18,14 @@ use mpm_solver::{
 };
 use nalgebra::SVector;
 
-use crate::body::InitialDomain;
-use crate::material::{SceneHistory, SceneLaws, scene_laws};
 use crate::run::{
     Analysis, DomainBounds, RunControl, RunOutput, Snapshot, StepObserver, simulate_points,
 };
-use crate::variant::{FormulationKind, LockingKind, VariantVisitor, dispatch};
+use mpm_scene::body::InitialDomain;
+use mpm_scene::material::{SceneHistory, SceneLaws, scene_laws};
+use mpm_scene::variant::{FormulationKind, LockingKind, VariantVisitor, dispatch};
 
-use super::build::{Problem, SceneMesh};
+use mpm_scene::build::{Problem, SceneMesh};
 
 /// Runs `problem`; `observer` sees every converged step.
 ///

@@ -15,12 +15,10 @@
 
 use mpm_constitutive::{
     HenckyElastic, IsotropicElasticity, LawState, LogStrainLaw, MaterialSet, NeoHookean,
-    SymSpectral, Tensor4, VonMises,
+    SymSpectral, Tagged, Tensor4, VonMises, VonMisesHistory,
 };
 use mpm_solver::{Flat, SolverError};
 use nalgebra::Vector3;
-
-use crate::run::HistoryOutput;
 
 /// The material parameters a law may read (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -296,6 +294,30 @@ register_laws! {
         yield_stress(p, "von_mises")?,
         p.hardening,
     );
+}
+
+/// Output quantities of a law's history.
+pub trait HistoryOutput {
+    /// Equivalent plastic strain (zero for elastic laws).
+    fn equivalent_plastic_strain(&self) -> f64;
+}
+
+impl HistoryOutput for () {
+    fn equivalent_plastic_strain(&self) -> f64 {
+        0.0
+    }
+}
+
+impl<H: HistoryOutput> HistoryOutput for Tagged<H> {
+    fn equivalent_plastic_strain(&self) -> f64 {
+        self.inner.equivalent_plastic_strain()
+    }
+}
+
+impl HistoryOutput for VonMisesHistory {
+    fn equivalent_plastic_strain(&self) -> f64 {
+        VonMisesHistory::equivalent_plastic_strain(self)
+    }
 }
 
 #[cfg(test)]

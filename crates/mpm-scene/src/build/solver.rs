@@ -4,22 +4,22 @@
 use mpm_solver::{LoadStepping, NewtonOptions};
 
 use super::Check;
-use crate::CasesError;
-use crate::scene::format::{LinearKind, SolverSpec};
-use crate::scene_file::SceneSource;
+use crate::SceneError;
+use crate::format::{LinearKind, SolverSpec};
+use crate::source::SceneSource;
 use toml::Spanned;
 
 /// The load stepping and Newton options of `s`; `grid`: the scene's mesh
 /// is a regular grid (the ghost penalty acts on its cells' faces).
 ///
 /// # Errors
-/// [`CasesError::Scene`] at the key whose value is out of range or does
+/// [`SceneError::Scene`] at the key whose value is out of range or does
 /// not apply.
 pub(super) fn newton_and_stepping(
     s: &SolverSpec,
     src: &SceneSource,
     grid: bool,
-) -> Result<(LoadStepping, NewtonOptions), CasesError> {
+) -> Result<(LoadStepping, NewtonOptions), SceneError> {
     let check = Check { src };
     let steps = check.at_least(&s.steps, 1, "solver `steps`")?;
     let initial = 1.0 / steps as f64;
@@ -135,12 +135,12 @@ pub(super) fn newton_and_stepping(
 /// the scene's mesh is a regular grid, whose cells' faces it acts on.
 ///
 /// # Errors
-/// [`CasesError::Scene`] at `ghost_penalty` or `ghost_fill`.
+/// [`SceneError::Scene`] at `ghost_penalty` or `ghost_fill`.
 fn ghost_penalty(
     s: &SolverSpec,
     src: &SceneSource,
     grid: bool,
-) -> Result<mpm_solver::GhostPenalty, CasesError> {
+) -> Result<mpm_solver::GhostPenalty, SceneError> {
     Ok(match (&s.ghost_penalty, &s.ghost_fill) {
         (None, Some(f)) => {
             return Err(src.at(f, "solver `ghost_fill` applies with `ghost_penalty`"));

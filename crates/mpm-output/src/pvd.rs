@@ -9,7 +9,7 @@ use std::path::{Component, Path, PathBuf};
 
 use super::atomic::atomic_write;
 use super::text::{push_f64, xml_escape};
-use crate::CasesError;
+use crate::OutputError;
 
 /// One step of a series: its time and the data file, as written into the
 /// `.pvd` (relative to the collection's directory where possible).
@@ -69,14 +69,14 @@ impl PvdSeries {
     /// If the write fails the step is not kept, so the call can be retried.
     ///
     /// # Errors
-    /// [`CasesError::InvalidTime`] unless `time` is finite and after the
-    /// previous step's; [`CasesError::InvalidPath`] if `file` is not valid
-    /// UTF-8 or has no file name; [`CasesError::Io`] if the collection cannot
+    /// [`OutputError::InvalidTime`] unless `time` is finite and after the
+    /// previous step's; [`OutputError::InvalidPath`] if `file` is not valid
+    /// UTF-8 or has no file name; [`OutputError::Io`] if the collection cannot
     /// be written.
-    pub fn push(&mut self, time: f64, file: &Path) -> Result<(), CasesError> {
+    pub fn push(&mut self, time: f64, file: &Path) -> Result<(), OutputError> {
         let previous = self.steps.last().map_or(f64::NEG_INFINITY, |s| s.time);
         if !time.is_finite() || time <= previous {
-            return Err(CasesError::InvalidTime { previous, time });
+            return Err(OutputError::InvalidTime { previous, time });
         }
         let file = self.relative_name(file)?;
         self.steps.push(PvdStep { time, file });
@@ -108,15 +108,15 @@ impl PvdSeries {
     /// Writes the collection as it stands, atomically.
     ///
     /// # Errors
-    /// [`CasesError::Io`] if the file cannot be written.
-    pub fn write(&self) -> Result<(), CasesError> {
+    /// [`OutputError::Io`] if the file cannot be written.
+    pub fn write(&self) -> Result<(), OutputError> {
         atomic_write(&self.path, self.to_xml().as_bytes())
     }
 
     /// `file` as it should appear in the collection.
-    fn relative_name(&self, file: &Path) -> Result<String, CasesError> {
+    fn relative_name(&self, file: &Path) -> Result<String, OutputError> {
         if file.file_name().is_none() {
-            return Err(CasesError::InvalidPath {
+            return Err(OutputError::InvalidPath {
                 path: file.to_path_buf(),
                 reason: "has no file name",
             });
@@ -130,7 +130,7 @@ impl PvdSeries {
         let mut parts = Vec::new();
         for c in relative.components() {
             match c {
-                Component::Normal(p) => parts.push(p.to_str().ok_or(CasesError::InvalidPath {
+                Component::Normal(p) => parts.push(p.to_str().ok_or(OutputError::InvalidPath {
                     path: file.to_path_buf(),
                     reason: "is not valid UTF-8",
                 })?),
@@ -142,7 +142,7 @@ impl PvdSeries {
                     return relative
                         .to_str()
                         .map(str::to_owned)
-                        .ok_or(CasesError::InvalidPath {
+                        .ok_or(OutputError::InvalidPath {
                             path: file.to_path_buf(),
                             reason: "is not valid UTF-8",
                         });

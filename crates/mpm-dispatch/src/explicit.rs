@@ -15,8 +15,9 @@
 //! without domains stores none.
 //!
 //! ```
-//! use mpm_cases::run::RunControl;
-//! use mpm_cases::scene::{self, ExplicitEvent, Problem};
+//! use mpm_dispatch::run::RunControl;
+//! use mpm_dispatch::{ExplicitEvent, run_explicit};
+//! use mpm_scene::Problem;
 //!
 //! // A free block moving at 1 m/s for 0.1 s: it translates rigidly.
 //! let text = r#"
@@ -42,10 +43,10 @@
 //! kind = "explicit"
 //! end_time = 0.1
 //! "#;
-//! let (scene, source) = scene::parse(text, "block.toml", &[])?;
+//! let (scene, source) = mpm_scene::parse(text, "block.toml", &[])?;
 //! let problem = Problem::<2>::build(&scene, &source, scene.solver.padding())?;
 //! let mut outputs = 0;
-//! let out = scene::run_explicit(&problem, &RunControl::default(), |event| {
+//! let out = run_explicit(&problem, &RunControl::default(), |event| {
 //!     if let ExplicitEvent::Output(_) = event {
 //!         outputs += 1;
 //!     }
@@ -74,11 +75,12 @@ use mpm_solver::{
 use nalgebra::{Matrix3, SVector};
 
 use crate::run::{Checkpoint, DomainBounds, HistoryOutput, RunControl, Snapshot};
-use crate::variant::{BasisKind, LockingKind};
+use mpm_scene::rules::Context;
+use mpm_scene::variant::{BasisKind, LockingKind};
 
-use super::build::{ExplicitSetup, Problem, SceneMesh};
-use super::explicit_law::{ExplicitLaw, ExplicitLaws};
-use super::format::TransferKind;
+use crate::explicit_law::{ExplicitLaw, ExplicitLaws};
+use mpm_scene::build::{ExplicitSetup, Problem, SceneMesh};
+use mpm_scene::format::TransferKind;
 
 /// What an explicit run reports to its observer.
 #[derive(Debug)]
@@ -217,6 +219,9 @@ fn dispatch<const D: usize>(
     observer: &mut ExplicitObserver<'_>,
 ) -> Result<ExplicitOutput, SolverError> {
     parts(problem)?;
+    (problem.variant)
+        .check(Context::Explicit)
+        .map_err(|refusal| SolverError::InvalidInput(refusal.message))?;
     let run = Run {
         problem,
         control,
@@ -300,7 +305,7 @@ impl<const D: usize> Run<'_, '_, D> {
             LockingKind::None => self.with(basis, rule, law, transfer, NoLocking),
             LockingKind::CellAveraged => self.with(basis, rule, law, transfer, CellAveraged),
             other => Err(SolverError::InvalidInput(format!(
-                "locking = {other} is an implicit treatment; the explicit solver takes none or cell_averaged"
+                "locking = {other}: refused by the rules (mpm_scene::rules)"
             ))),
         }
     }

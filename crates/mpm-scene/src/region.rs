@@ -4,10 +4,10 @@
 use nalgebra::SVector;
 use toml::Spanned;
 
-use crate::CasesError;
-use crate::scene_file::SceneSource;
+use crate::SceneError;
+use crate::source::SceneSource;
 
-use super::format::RegionSpec;
+use crate::format::RegionSpec;
 
 /// Points closer than this (relative to the region's size) to a region's
 /// boundary count as inside: a body whose box ends on a cell face keeps
@@ -45,7 +45,7 @@ pub fn point<const D: usize>(
     values: &Spanned<Vec<f64>>,
     what: &str,
     src: &SceneSource,
-) -> Result<SVector<f64, D>, CasesError> {
+) -> Result<SVector<f64, D>, SceneError> {
     if values.get_ref().len() != D {
         return Err(src.at(
             values,
@@ -64,8 +64,8 @@ impl<const D: usize> Region<D> {
     /// positive radii, non-empty unions and differences.
     ///
     /// # Errors
-    /// [`CasesError::Scene`] at the offending value.
-    pub fn new(spec: &RegionSpec, src: &SceneSource) -> Result<Self, CasesError> {
+    /// [`SceneError::Scene`] at the offending value.
+    pub fn new(spec: &RegionSpec, src: &SceneSource) -> Result<Self, SceneError> {
         Ok(match spec {
             RegionSpec::Box { lower, upper } => {
                 let lo = point::<D>(lower, "box `lower`", src)?;

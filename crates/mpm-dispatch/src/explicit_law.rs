@@ -17,7 +17,7 @@ use nalgebra::Matrix3;
 /// The constitutive crate's result.
 type Result<T, E = mpm_constitutive::ConstitutiveError> = std::result::Result<T, E>;
 
-use crate::material::{MaterialModel, MaterialParams, SceneHistory, SceneLaw};
+use mpm_scene::material::{MaterialModel, MaterialParams, SceneHistory, SceneLaw};
 
 /// The laws of a scene's materials for the explicit solver: material `k`
 /// is law `k`, each point's state tagged with its material.
@@ -162,6 +162,6 @@ mod tests {
         for df in increments() {
             any.update(&df, &mut s).expect("update");
         }
-        assert!(crate::run::HistoryOutput::equivalent_plastic_strain(&s.history) > 0.0);
+        assert!(mpm_scene::material::HistoryOutput::equivalent_plastic_strain(&s.history) > 0.0);
     }
 }

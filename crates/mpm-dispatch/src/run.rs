@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use mpm_constitutive::{LogStrainLaw, Tagged, VonMisesHistory};
+use mpm_constitutive::LogStrainLaw;
 use mpm_solver::{
     BodyForcePath, Constraints, DomainUpdater, Flat, Formulation, ImplicitSolver, LoadStepping,
     LockingTreatment, MaterialPoints, MovableMesh, NewtonOptions, NoLocking, NodalMesh, Parts,
@@ -10,38 +10,16 @@ use mpm_solver::{
 };
 use nalgebra::SVector;
 
-use crate::body::{Body, InitialDomain};
-use mpm_basis::Corners;
+pub use mpm_scene::body::{DomainBounds, InitialDomain};
+pub use mpm_scene::material::HistoryOutput;
+
+use mpm_scene::body::Body;
 
 /// What sees each converged step: its number, its report and the state
 /// after it. Runs take it as a trait object, so the solver behind a run is
 /// compiled once per variant, not once more for every caller's closure.
 pub type StepObserver<'a, const D: usize> =
     dyn FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError> + 'a;
-
-/// Output quantities of a law's history.
-pub trait HistoryOutput {
-    /// Equivalent plastic strain (zero for elastic laws).
-    fn equivalent_plastic_strain(&self) -> f64;
-}
-
-impl HistoryOutput for () {
-    fn equivalent_plastic_strain(&self) -> f64 {
-        0.0
-    }
-}
-
-impl<H: HistoryOutput> HistoryOutput for Tagged<H> {
-    fn equivalent_plastic_strain(&self) -> f64 {
-        self.inner.equivalent_plastic_strain()
-    }
-}
-
-impl HistoryOutput for VonMisesHistory {
-    fn equivalent_plastic_strain(&self) -> f64 {
-        VonMisesHistory::equivalent_plastic_strain(self)
-    }
-}
 
 /// Each point's domain box (in 3 components), for the snapshots; empty for
 /// bases without domains.
@@ -55,35 +33,6 @@ pub(crate) fn domain_bounds<const D: usize, Dom: DomainBounds<D>>(
         .zip(positions)
         .filter_map(|(d, x)| d.bounds(x).map(|(lo, hi)| (pad(&lo), pad(&hi))))
         .collect()
-}
-
-/// The box a material point's domain covers, for output and for measuring
-/// a body by its domains (Coombs 2020 Table 7).
-pub trait DomainBounds<const D: usize> {
-    /// Lower and upper corners of the domain's bounding box, or `None` for
-    /// bases without a domain.
-    fn bounds(&self, position: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)>;
-}
-
-impl<const D: usize> DomainBounds<D> for () {
-    fn bounds(&self, _: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
-        None
-    }
-}
-
-/// GIMP: the box $\mathbf x_p \pm \mathbf l_p$.
-impl<const D: usize> DomainBounds<D> for SVector<f64, D> {
-    fn bounds(&self, position: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
-        Some((position - self, position + self))
-    }
-}
-
-/// CPDI2: the bounding box of the corners.
-impl<const D: usize> DomainBounds<D> for Corners<D> {
-    fn bounds(&self, _: &SVector<f64, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
-        let b = self.bounding_box();
-        Some((b.lower, b.upper))
-    }
 }
 
 /// A plain copy of the material point state after a step, for output and

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use super::atomic::atomic_write;
 use super::text::format_f64;
-use crate::CasesError;
+use crate::OutputError;
 
 /// One field of a row.
 #[derive(Debug, Clone, PartialEq)]
@@ -87,11 +87,11 @@ impl CsvTable {
     /// An empty table with the given column names.
     ///
     /// # Errors
-    /// [`CasesError::InvalidName`] if there are no columns, or a name is
+    /// [`OutputError::InvalidName`] if there are no columns, or a name is
     /// empty or repeated.
-    pub fn new<S: AsRef<str>>(header: &[S]) -> Result<Self, CasesError> {
+    pub fn new<S: AsRef<str>>(header: &[S]) -> Result<Self, OutputError> {
         if header.is_empty() {
-            return Err(CasesError::InvalidName {
+            return Err(OutputError::InvalidName {
                 what: "CSV column",
                 name: String::new(),
                 reason: "a table needs at least one column",
@@ -108,7 +108,7 @@ impl CsvTable {
                 None
             };
             if let Some(reason) = reason {
-                return Err(CasesError::InvalidName {
+                return Err(OutputError::InvalidName {
                     what: "CSV column",
                     name: h.to_owned(),
                     reason,
@@ -137,13 +137,13 @@ impl CsvTable {
     /// Appends a row. Nothing is appended if the row is invalid.
     ///
     /// # Errors
-    /// [`CasesError::LengthMismatch`] (array `row <i>`) unless the row has
-    /// one value per column; [`CasesError::NonFinite`] naming the column and
+    /// [`OutputError::LengthMismatch`] (array `row <i>`) unless the row has
+    /// one value per column; [`OutputError::NonFinite`] naming the column and
     /// the row index if a float is NaN or infinite.
-    pub fn push_row(&mut self, row: &[CsvValue<'_>]) -> Result<(), CasesError> {
+    pub fn push_row(&mut self, row: &[CsvValue<'_>]) -> Result<(), OutputError> {
         let index = self.lines.len();
         if row.len() != self.header.len() {
-            return Err(CasesError::LengthMismatch {
+            return Err(OutputError::LengthMismatch {
                 array: format!("row {index}"),
                 expected: self.header.len(),
                 found: row.len(),
@@ -153,7 +153,7 @@ impl CsvTable {
         for (value, column) in row.iter().zip(&self.header) {
             fields.push(match value {
                 CsvValue::Float(x) if !x.is_finite() => {
-                    return Err(CasesError::NonFinite {
+                    return Err(OutputError::NonFinite {
                         array: column.clone(),
                         index,
                         value: *x,
@@ -189,8 +189,8 @@ impl CsvTable {
     /// Writes the table to `path` atomically.
     ///
     /// # Errors
-    /// [`CasesError::Io`] if the file cannot be written.
-    pub fn write(&self, path: &Path) -> Result<(), CasesError> {
+    /// [`OutputError::Io`] if the file cannot be written.
+    pub fn write(&self, path: &Path) -> Result<(), OutputError> {
         atomic_write(path, self.to_csv().as_bytes())
     }
 }

@@ -7,20 +7,20 @@ use serde::Serialize;
 
 use super::atomic::atomic_write;
 use super::finite::find_non_finite;
-use crate::CasesError;
+use crate::OutputError;
 
 /// The JSON text of `value`, pretty-printed with a final newline.
 ///
 /// # Errors
-/// [`CasesError::NonFiniteField`] naming the first NaN or infinite float
+/// [`OutputError::NonFiniteField`] naming the first NaN or infinite float
 /// (`serde_json` would silently write it as `null`);
-/// [`CasesError::Json`] (with `path` as the intended file) if `value`'s
+/// [`OutputError::Json`] (with `path` as the intended file) if `value`'s
 /// `Serialize` implementation fails, e.g. a map with non-string keys.
-pub fn summary_json<T: Serialize + ?Sized>(value: &T, path: &Path) -> Result<String, CasesError> {
+pub fn summary_json<T: Serialize + ?Sized>(value: &T, path: &Path) -> Result<String, OutputError> {
     if let Some((field, value)) = find_non_finite(value) {
-        return Err(CasesError::NonFiniteField { field, value });
+        return Err(OutputError::NonFiniteField { field, value });
     }
-    let mut text = serde_json::to_string_pretty(value).map_err(|source| CasesError::Json {
+    let mut text = serde_json::to_string_pretty(value).map_err(|source| OutputError::Json {
         path: path.to_path_buf(),
         source,
     })?;
@@ -32,9 +32,9 @@ pub fn summary_json<T: Serialize + ?Sized>(value: &T, path: &Path) -> Result<Str
 /// `summary.json`), atomically.
 ///
 /// # Errors
-/// As [`summary_json`], and [`CasesError::Io`] if the file cannot be
+/// As [`summary_json`], and [`OutputError::Io`] if the file cannot be
 /// written. On error the old file, if any, is left as it was.
-pub fn write_summary<T: Serialize + ?Sized>(path: &Path, value: &T) -> Result<(), CasesError> {
+pub fn write_summary<T: Serialize + ?Sized>(path: &Path, value: &T) -> Result<(), OutputError> {
     let text = summary_json(value, path)?;
     atomic_write(path, text.as_bytes())
 }

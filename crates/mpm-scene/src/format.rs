@@ -1,6 +1,6 @@
 //! The scene file format: what a TOML scene deserialises into, before any
 //! check across sections (names that refer to nothing, bodies outside the
-//! mesh; [`super::build`]). Every table refuses unknown keys. Fields that
+//! mesh; [`crate::build`]). Every table refuses unknown keys. Fields that
 //! other sections refer to, or whose value is checked later, keep their
 //! place in the file (`Spanned`) so that the error can name it.
 //!
@@ -495,7 +495,7 @@ pub enum SolverKind {
 pub use crate::variant::TransferKind;
 
 /// `[solver]`. The keys of one solver kind are refused with the other
-/// ([`super::build`]): Newton and load-stepping keys with `kind =
+/// ([`crate::build`]): Newton and load-stepping keys with `kind =
 /// "explicit"`, time-stepping keys with `kind = "implicit"`. Values whose
 /// presence matters keep their place (`Spanned`; a default has the empty
 /// span `0..0`).
@@ -688,7 +688,42 @@ impl Default for SolverSpec {
     }
 }
 
-pub use crate::writer::Field;
+/// Fields of the material-point VTU files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Field {
+    /// Total displacement (`displacement`).
+    Displacement,
+    /// Velocity (`velocity`; explicit runs).
+    Velocity,
+    /// Cauchy stress (`cauchy_stress`).
+    Stress,
+    /// Deformation gradient (`deformation_gradient`).
+    DeformationGradient,
+    /// Volume (`volume`).
+    Volume,
+    /// Equivalent plastic strain (`equivalent_plastic_strain`).
+    PlasticStrain,
+    /// GIMP/CPDI2 domain bounds (`domain_lower`, `domain_upper`).
+    Domain,
+    /// The per-point constants of the writer's per-point constants (e.g. a scene's
+    /// body and material indices).
+    Body,
+}
+
+impl Field {
+    /// Every field.
+    pub const ALL: [Field; 8] = [
+        Field::Displacement,
+        Field::Velocity,
+        Field::Stress,
+        Field::DeformationGradient,
+        Field::Volume,
+        Field::PlasticStrain,
+        Field::Domain,
+        Field::Body,
+    ];
+}
 
 /// A reaction history: the sum of the reactions on a node set.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -700,7 +735,7 @@ pub struct ReactionSpec {
     pub set: Spanned<String>,
     /// Also write the moment of the reactions about this point (2D: a
     /// scalar about the out-of-plane axis; 3D: a vector); see
-    /// [`crate::scene::build::ReactionOutput::moment`].
+    /// [`crate::build::ReactionOutput::moment`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub about: Option<Spanned<Vec<f64>>>,
 }

@@ -5,7 +5,7 @@
 //! The grid is built from plain slices, so the solver needs no VTK types:
 //!
 //! ```no_run
-//! # fn main() -> Result<(), mpm_cases::CasesError> {
+//! # fn main() -> Result<(), mpm_cases::OutputError> {
 //! use mpm_cases::output::vtk::{UnstructuredGrid, Values};
 //! let x = [[0.0, 0.0], [1.0, 0.5]]; // 2D positions, written with z = 0
 //! let p = [1.0e3, 2.0e3];
@@ -27,7 +27,7 @@ use std::path::Path;
 
 use super::atomic::atomic_write_with;
 use super::text::{check_finite, push_f64, xml_escape};
-use crate::CasesError;
+use crate::OutputError;
 
 /// The VTK cell types the writer supports, with VTK's node ordering.
 ///
@@ -149,10 +149,10 @@ impl<'a> Values<'a> {
     /// components, e.g. 2D velocities.
     ///
     /// # Errors
-    /// [`CasesError::InvalidDimension`] unless `1 <= D <= 3`.
+    /// [`OutputError::InvalidDimension`] unless `1 <= D <= 3`.
     pub fn vectors_padded<const D: usize>(
         values: &[[f64; D]],
-    ) -> Result<Values<'static>, CasesError> {
+    ) -> Result<Values<'static>, OutputError> {
         let padded = pad_to_3d(values)?;
         Ok(Values::Float64 {
             data: Cow::Owned(padded.into_flattened()),
@@ -186,9 +186,9 @@ impl<'a> Values<'a> {
 }
 
 /// Pads `D`-dimensional coordinates to three with zeros.
-fn pad_to_3d<const D: usize>(values: &[[f64; D]]) -> Result<Vec<[f64; 3]>, CasesError> {
+fn pad_to_3d<const D: usize>(values: &[[f64; D]]) -> Result<Vec<[f64; 3]>, OutputError> {
     if D == 0 || D > 3 {
-        return Err(CasesError::InvalidDimension { dim: D });
+        return Err(OutputError::InvalidDimension { dim: D });
     }
     Ok(values
         .iter()
@@ -227,9 +227,9 @@ impl<'a> UnstructuredGrid<'a> {
     /// A grid with the given 3D points (borrowed) and no cells.
     ///
     /// # Errors
-    /// [`CasesError::NonFinite`] (array `"Points"`) if a coordinate is NaN
+    /// [`OutputError::NonFinite`] (array `"Points"`) if a coordinate is NaN
     /// or infinite.
-    pub fn new(points: &'a [[f64; 3]]) -> Result<Self, CasesError> {
+    pub fn new(points: &'a [[f64; 3]]) -> Result<Self, OutputError> {
         Self::with_points(Cow::Borrowed(points))
     }
 
@@ -237,13 +237,13 @@ impl<'a> UnstructuredGrid<'a> {
     /// coordinates, and no cells.
     ///
     /// # Errors
-    /// [`CasesError::InvalidDimension`] for `D` outside `1..=3`;
-    /// [`CasesError::NonFinite`] as [`UnstructuredGrid::new`].
-    pub fn from_points<const D: usize>(points: &[[f64; D]]) -> Result<Self, CasesError> {
+    /// [`OutputError::InvalidDimension`] for `D` outside `1..=3`;
+    /// [`OutputError::NonFinite`] as [`UnstructuredGrid::new`].
+    pub fn from_points<const D: usize>(points: &[[f64; D]]) -> Result<Self, OutputError> {
         Self::with_points(Cow::Owned(pad_to_3d(points)?))
     }
 
-    fn with_points(points: Cow<'a, [[f64; 3]]>) -> Result<Self, CasesError> {
+    fn with_points(points: Cow<'a, [[f64; 3]]>) -> Result<Self, OutputError> {
         check_finite("Points", points.as_flattened(), 3)?;
         Ok(Self {
             points,
@@ -285,17 +285,17 @@ impl<'a> UnstructuredGrid<'a> {
     /// Nothing is added if the list is invalid.
     ///
     /// # Errors
-    /// [`CasesError::CellNodeCount`] if the list's length is not a multiple
-    /// of the type's node count; [`CasesError::NodeOutOfRange`] if an index
+    /// [`OutputError::CellNodeCount`] if the list's length is not a multiple
+    /// of the type's node count; [`OutputError::NodeOutOfRange`] if an index
     /// is not a point (the cell index counts all cells of the grid).
     pub fn add_cells(
         &mut self,
         cell_type: CellType,
         connectivity: &[usize],
-    ) -> Result<&mut Self, CasesError> {
+    ) -> Result<&mut Self, OutputError> {
         let n = cell_type.n_nodes();
         if !connectivity.len().is_multiple_of(n) {
-            return Err(CasesError::CellNodeCount {
+            return Err(OutputError::CellNodeCount {
                 cell_type: cell_type.name(),
                 expected: n,
                 found: connectivity.len(),
@@ -305,7 +305,7 @@ impl<'a> UnstructuredGrid<'a> {
             .iter()
             .position(|&node| node >= self.points.len())
         {
-            return Err(CasesError::NodeOutOfRange {
+            return Err(OutputError::NodeOutOfRange {
                 cell: self.n_cells() + i / n,
                 node: connectivity[i],
                 n_points: self.points.len(),
@@ -322,13 +322,13 @@ impl<'a> UnstructuredGrid<'a> {
     /// Adds a `Float64` or `Int64` array on the points.
     ///
     /// # Errors
-    /// [`CasesError::InvalidName`] for an empty name or one already used on
-    /// the points; [`CasesError::LengthMismatch`] unless there is one tuple
+    /// [`OutputError::InvalidName`] for an empty name or one already used on
+    /// the points; [`OutputError::LengthMismatch`] unless there is one tuple
     /// per point (and the flat length is a multiple of the component count);
-    /// [`CasesError::ZeroComponents`] for `Float64` data with zero
-    /// components; [`CasesError::NonFinite`] naming the array and point
+    /// [`OutputError::ZeroComponents`] for `Float64` data with zero
+    /// components; [`OutputError::NonFinite`] naming the array and point
     /// index.
-    pub fn point_data(&mut self, name: &str, values: Values<'a>) -> Result<&mut Self, CasesError> {
+    pub fn point_data(&mut self, name: &str, values: Values<'a>) -> Result<&mut Self, OutputError> {
         check_array(name, &values, &self.point_data, "point data array")?;
         check_length(name, &values, self.points.len())?;
         self.point_data.push(DataArray {
@@ -342,12 +342,12 @@ impl<'a> UnstructuredGrid<'a> {
     /// against the number of cells when the grid is written.
     ///
     /// # Errors
-    /// [`CasesError::InvalidName`] for an empty name or one already used on
-    /// the cells; [`CasesError::LengthMismatch`] if the flat length is not a
-    /// multiple of the component count; [`CasesError::ZeroComponents`] for
-    /// `Float64` data with zero components; [`CasesError::NonFinite`] naming
+    /// [`OutputError::InvalidName`] for an empty name or one already used on
+    /// the cells; [`OutputError::LengthMismatch`] if the flat length is not a
+    /// multiple of the component count; [`OutputError::ZeroComponents`] for
+    /// `Float64` data with zero components; [`OutputError::NonFinite`] naming
     /// the array and cell index.
-    pub fn cell_data(&mut self, name: &str, values: Values<'a>) -> Result<&mut Self, CasesError> {
+    pub fn cell_data(&mut self, name: &str, values: Values<'a>) -> Result<&mut Self, OutputError> {
         check_array(name, &values, &self.cell_data, "cell data array")?;
         self.cell_data.push(DataArray {
             name: name.to_owned(),
@@ -359,8 +359,8 @@ impl<'a> UnstructuredGrid<'a> {
     /// Checks that every cell data array has one tuple per cell.
     ///
     /// # Errors
-    /// [`CasesError::LengthMismatch`] naming the first array that does not.
-    pub fn validate(&self) -> Result<(), CasesError> {
+    /// [`OutputError::LengthMismatch`] naming the first array that does not.
+    pub fn validate(&self) -> Result<(), OutputError> {
         for a in &self.cell_data {
             check_length(&a.name, &a.values, self.n_cells())?;
         }
@@ -371,7 +371,7 @@ impl<'a> UnstructuredGrid<'a> {
     ///
     /// # Errors
     /// As [`UnstructuredGrid::validate`].
-    pub fn to_xml(&self) -> Result<String, CasesError> {
+    pub fn to_xml(&self) -> Result<String, OutputError> {
         self.validate()?;
         let mut buf = Vec::new();
         // Writing into a Vec cannot fail, and only `&str`s and numbers are
@@ -384,9 +384,9 @@ impl<'a> UnstructuredGrid<'a> {
     /// atomically: a reader sees the old file or the complete new one.
     ///
     /// # Errors
-    /// As [`UnstructuredGrid::validate`], and [`CasesError::Io`] if the file
+    /// As [`UnstructuredGrid::validate`], and [`OutputError::Io`] if the file
     /// cannot be written.
-    pub fn write(&self, path: &Path) -> Result<(), CasesError> {
+    pub fn write(&self, path: &Path) -> Result<(), OutputError> {
         self.validate()?;
         atomic_write_with(path, |w| self.write_xml(w))
     }
@@ -430,16 +430,16 @@ fn check_array(
     values: &Values<'_>,
     existing: &[DataArray<'_>],
     what: &'static str,
-) -> Result<(), CasesError> {
+) -> Result<(), OutputError> {
     if name.trim().is_empty() {
-        return Err(CasesError::InvalidName {
+        return Err(OutputError::InvalidName {
             what,
             name: name.to_owned(),
             reason: "must not be empty",
         });
     }
     if existing.iter().any(|a| a.name == name) {
-        return Err(CasesError::InvalidName {
+        return Err(OutputError::InvalidName {
             what,
             name: name.to_owned(),
             reason: "is already used",
@@ -448,12 +448,12 @@ fn check_array(
     match values {
         Values::Float64 { data, components } => {
             if *components == 0 {
-                return Err(CasesError::ZeroComponents {
+                return Err(OutputError::ZeroComponents {
                     array: name.to_owned(),
                 });
             }
             if !data.len().is_multiple_of(*components) {
-                return Err(CasesError::LengthMismatch {
+                return Err(OutputError::LengthMismatch {
                     array: name.to_owned(),
                     expected: data.len().next_multiple_of(*components),
                     found: data.len(),
@@ -466,11 +466,11 @@ fn check_array(
 }
 
 /// Checks that `values` holds one tuple per item.
-fn check_length(name: &str, values: &Values<'_>, n: usize) -> Result<(), CasesError> {
+fn check_length(name: &str, values: &Values<'_>, n: usize) -> Result<(), OutputError> {
     if values.n_tuples() == n {
         Ok(())
     } else {
-        Err(CasesError::LengthMismatch {
+        Err(OutputError::LengthMismatch {
             array: name.to_owned(),
             expected: n,
             found: values.n_tuples(),

@@ -19,16 +19,16 @@ use mpm_solver::{
 use nalgebra::SVector;
 use toml::Spanned;
 
-use crate::CasesError;
+use crate::SceneError;
 use crate::material::{MaterialModel, MaterialParams};
-use crate::scene_file::SceneSource;
-use crate::variant::{BasisKind, DomainUpdateKind, LockingKind, Variant};
+use crate::source::SceneSource;
+use crate::variant::{LockingKind, Variant};
 
-use super::format::{
+use crate::format::{
     BoundaryKind, Field, LoadKind, MeshKind, MotionKind, Placement, RegionSpec, Scene, SolverKind,
     SolverSpec, TransferKind,
 };
-use super::region::{Region, point};
+use crate::region::{Region, point};
 
 /// Largest number of grid nodes, simplices or material points a scene may
 /// ask for (a guard against a typo allocating the machine's memory).
@@ -368,7 +368,7 @@ pub struct Problem<const D: usize> {
     /// Write a PNG of the final state.
     pub png: bool,
     /// The explicit solver's setup, for a scene with `[solver] kind =
-    /// "explicit"` (run it with [`super::run_explicit`]); `None` for the
+    /// "explicit"` (run it with `run_explicit` (the `mpm-dispatch` crate)); `None` for the
     /// implicit solver.
     pub explicit: Option<ExplicitSetup<D>>,
     /// What the scene may not mean but is allowed: a simplex mesh's
@@ -438,7 +438,7 @@ struct Check<'a> {
 }
 
 impl Check<'_> {
-    fn positive(&self, v: &Spanned<f64>, what: &str) -> Result<f64, CasesError> {
+    fn positive(&self, v: &Spanned<f64>, what: &str) -> Result<f64, SceneError> {
         let x = *v.get_ref();
         if x > 0.0 {
             Ok(x)
@@ -447,7 +447,7 @@ impl Check<'_> {
         }
     }
 
-    fn at_least(&self, v: &Spanned<usize>, min: usize, what: &str) -> Result<usize, CasesError> {
+    fn at_least(&self, v: &Spanned<usize>, min: usize, what: &str) -> Result<usize, SceneError> {
         let x = *v.get_ref();
         if x >= min {
             Ok(x)
@@ -464,7 +464,7 @@ fn unique_names<'a>(
     names: impl Iterator<Item = &'a Spanned<String>>,
     section: &str,
     src: &SceneSource,
-) -> Result<BTreeMap<String, usize>, CasesError> {
+) -> Result<BTreeMap<String, usize>, SceneError> {
     let mut map = BTreeMap::new();
     for (k, name) in names.enumerate() {
         if name.get_ref().is_empty() {
@@ -486,7 +486,7 @@ fn lookup(
     name: &Spanned<String>,
     section: &str,
     src: &SceneSource,
-) -> Result<usize, CasesError> {
+) -> Result<usize, SceneError> {
     lookup_ref(map, name, section, src).copied()
 }
 
@@ -496,7 +496,7 @@ fn lookup_ref<'m, V>(
     name: &Spanned<String>,
     section: &str,
     src: &SceneSource,
-) -> Result<&'m V, CasesError> {
+) -> Result<&'m V, SceneError> {
     map.get(name.get_ref()).ok_or_else(|| {
         let known: Vec<&str> = map.keys().map(String::as_str).collect();
         src.at(
@@ -519,14 +519,14 @@ impl<const D: usize> Problem<D> {
     /// (and at least what the scene's basis needs, [`SolverSpec::padding`]).
     ///
     /// # Errors
-    /// [`CasesError::Scene`] (or [`CasesError::Override`]) at the value
-    /// that is wrong, [`CasesError::SceneUnlocated`] for what has no single
+    /// [`SceneError::Scene`] (or [`SceneError::Override`]) at the value
+    /// that is wrong, [`SceneError::SceneUnlocated`] for what has no single
     /// place.
     pub fn build(
         scene: &Scene,
         src: &SceneSource,
         basis_padding: usize,
-    ) -> Result<Self, CasesError> {
+    ) -> Result<Self, SceneError> {
         let dir = std::path::Path::new(src.origin())
             .parent()
             .map(std::path::Path::to_path_buf)
@@ -544,7 +544,7 @@ impl<const D: usize> Problem<D> {
         src: &SceneSource,
         basis_padding: usize,
         mesh_dir: &std::path::Path,
-    ) -> Result<Self, CasesError> {
+    ) -> Result<Self, SceneError> {
         let check = Check { src };
         let solver = &scene.solver;
         let explicit_keys = solver_keys(solver, src)?;
@@ -556,24 +556,11 @@ impl<const D: usize> Problem<D> {
             domain_update: *solver.domain_update.get_ref(),
             gimp_volume: *solver.gimp_volume.get_ref(),
         };
-        // The pairs the variant dispatch accepts, refused here at the key
-        // rather than when the run starts.
-        let (update, basis) = (variant.domain_update, variant.basis);
-        let misfit = match (basis, update) {
-            (_, DomainUpdateKind::None) | (BasisKind::Cpdi2, DomainUpdateKind::Cpdi2) => None,
-            (BasisKind::Gimp, DomainUpdateKind::Cpdi2) => Some(
-                "domain_update = cpdi2 convects CPDI2 corners; use it with basis = cpdi2"
-                    .to_owned(),
-            ),
-            (BasisKind::Gimp, _) => None,
-            (BasisKind::Cpdi2, other) => Some(format!(
-                "basis = cpdi2 convects its corners with the grid; domain_update = {other} applies to gimp only"
-            )),
-            (other, _) => Some(format!(
-                "domain_update = {update} needs basis = gimp ({other} has no domain to update)"
-            )),
-        };
-        if let Some(message) = misfit {
+        // The basis and domain rule must fit whatever the mesh (the rest of
+        // the table needs the mesh and is checked with it).
+        if let Some(message) =
+            crate::rules::domain_update_fits_basis(&variant, crate::rules::Context::ImplicitGrid)
+        {
             return Err(src.at(&solver.domain_update, message));
         }
         let basis_padding = basis_padding.max(solver.padding());
@@ -855,7 +842,7 @@ impl<const D: usize> Problem<D> {
 
         // Curves (index 0: the default ramp).
         let (curve_names, curves) = curves::curves(&scene.curves, src)?;
-        let curve_of = |name: &Option<Spanned<String>>| -> Result<usize, CasesError> {
+        let curve_of = |name: &Option<Spanned<String>>| -> Result<usize, SceneError> {
             match name {
                 None => Ok(0),
                 Some(n) => lookup(&curve_names, n, "curve", src).map(|k| k + 1),
@@ -1185,7 +1172,7 @@ impl<const D: usize> Problem<D> {
             }
             sets.insert(spec.name.get_ref().clone(), nodes);
         }
-        let set_of = |name: &Spanned<String>| -> Result<&Vec<usize>, CasesError> {
+        let set_of = |name: &Spanned<String>| -> Result<&Vec<usize>, SceneError> {
             if following_sets.contains_key(name.get_ref()) {
                 return Err(src.at(
                     name,
@@ -1852,13 +1839,13 @@ impl<const D: usize> Problem<D> {
 /// The regular grid of `[mesh]`: its cells (or spacing), padding and
 /// origin; returns the grid, the unpadded box and the padding.
 fn grid_mesh<const D: usize>(
-    m: &super::format::MeshSpec,
+    m: &crate::format::MeshSpec,
     origin_spec: &Spanned<Vec<f64>>,
     size_spec: &Spanned<Vec<f64>>,
     basis_padding: usize,
     variant: &Variant,
     src: &SceneSource,
-) -> Result<(RegularGrid<D>, SVector<f64, D>, SVector<f64, D>, usize), CasesError> {
+) -> Result<(RegularGrid<D>, SVector<f64, D>, SVector<f64, D>, usize), SceneError> {
     let origin = point::<D>(origin_spec, "mesh `origin`", src)?;
     let size = point::<D>(size_spec, "mesh `size`", src)?;
     if let Some(axis) = (0..D).find(|&i| size[i] <= 0.0) {
@@ -1953,12 +1940,12 @@ type RectilinearBox<const D: usize> = (SVector<f64, D>, SVector<f64, D>, [Vec<f6
 /// increasing rows from `origin` to `origin + size`, given instead of
 /// `cells` and `spacing`; with the box's corners.
 fn coordinate_lines<const D: usize>(
-    m: &super::format::MeshSpec,
+    m: &crate::format::MeshSpec,
     c: &Spanned<Vec<Vec<f64>>>,
     origin_spec: &Spanned<Vec<f64>>,
     size_spec: &Spanned<Vec<f64>>,
     src: &SceneSource,
-) -> Result<RectilinearBox<D>, CasesError> {
+) -> Result<RectilinearBox<D>, SceneError> {
     if m.cells.is_some() || m.spacing.is_some() {
         return Err(src.at(
             c,
@@ -2044,14 +2031,14 @@ pub const MANUFACTURED_FIELDS: [(&str, &[&str]); 1] = [(
 /// per unit volume at amplitude `curve(λ)` times the point's volume.
 #[allow(clippy::too_many_arguments)]
 fn manufactured_force<const D: usize>(
-    spec: &super::format::LoadSpec,
+    spec: &crate::format::LoadSpec,
     range: std::ops::Range<usize>,
     position: &[SVector<f64, D>],
     volume: &[f64],
     shear_modulus: Vec<f64>,
     curve: Curve,
     src: &SceneSource,
-) -> Result<BodyForcePath<D>, CasesError> {
+) -> Result<BodyForcePath<D>, SceneError> {
     use std::sync::Arc;
     let Some(field) = &spec.field else {
         return Err(src.at(
@@ -2086,7 +2073,7 @@ fn manufactured_force<const D: usize>(
             ),
         ));
     }
-    let value = |key: &str| -> Result<f64, CasesError> {
+    let value = |key: &str| -> Result<f64, SceneError> {
         match given.get_ref().get(key) {
             Some(v) if v.is_finite() => Ok(*v),
             Some(v) => Err(src.at(given, format!("`{key}` must be finite, got {v}"))),
@@ -2132,19 +2119,19 @@ fn manufactured_force<const D: usize>(
 /// The components of a `displacement` table, checked against the
 /// dimension (at least one given).
 fn displacement_of<const D: usize>(
-    d: &Spanned<super::format::Axes>,
+    d: &Spanned<crate::format::Axes>,
     src: &SceneSource,
-) -> Result<[Option<f64>; 3], CasesError> {
+) -> Result<[Option<f64>; 3], SceneError> {
     axes_of::<D>(d, "displacement", src)
 }
 
 /// The components of a per-axis table named `key`, checked against the
 /// dimension (at least one given, all finite).
 fn axes_of<const D: usize>(
-    d: &Spanned<super::format::Axes>,
+    d: &Spanned<crate::format::Axes>,
     key: &str,
     src: &SceneSource,
-) -> Result<[Option<f64>; 3], CasesError> {
+) -> Result<[Option<f64>; 3], SceneError> {
     let values = d.get_ref().get();
     if let Some(axis) = (D..3).find(|&i| values[i].is_some()) {
         return Err(src.at(d, format!("a {D}D scene has no {} component", AXES[axis])));
@@ -2172,7 +2159,7 @@ fn boundary_kind_name(kind: BoundaryKind) -> &'static str {
 fn gradient_of<const D: usize>(
     g: &Spanned<Vec<Vec<f64>>>,
     src: &SceneSource,
-) -> Result<nalgebra::SMatrix<f64, D, D>, CasesError> {
+) -> Result<nalgebra::SMatrix<f64, D, D>, SceneError> {
     let rows = g.get_ref();
     if rows.len() != D || rows.iter().any(|r| r.len() != D) {
         return Err(src.at(
@@ -2212,13 +2199,13 @@ impl<const D: usize> MeshMotion<D> for SceneMotion<D> {
 
 /// The mesh motion of `[mesh.motion]`.
 fn motion_of<const D: usize>(
-    spec: &super::format::MotionSpec,
+    spec: &crate::format::MotionSpec,
     sets: &BTreeMap<String, Vec<usize>>,
     initial: &[SVector<f64, D>],
     lower: SVector<f64, D>,
     upper: SVector<f64, D>,
     src: &SceneSource,
-) -> Result<MovingMesh<D, Free, SceneMotion<D>>, CasesError> {
+) -> Result<MovingMesh<D, Free, SceneMotion<D>>, SceneError> {
     let axis_of = |name: &str| AXES.iter().take(D).position(|a| *a == name);
     let axis =
         match &spec.axis {
@@ -2227,7 +2214,7 @@ fn motion_of<const D: usize>(
             })?),
             None => None,
         };
-    let refuse = |present: bool, key: &str, kind: &str| -> Result<(), CasesError> {
+    let refuse = |present: bool, key: &str, kind: &str| -> Result<(), SceneError> {
         if present {
             Err(src.at(
                 &spec.kind,
@@ -2417,7 +2404,7 @@ impl<const D: usize> Points<D> {
         anchor: Option<SVector<f64, D>>,
         src: &SceneSource,
         ppc_span: &Spanned<usize>,
-    ) -> Result<SVector<f64, D>, CasesError> {
+    ) -> Result<SVector<f64, D>, SceneError> {
         let h = *grid.spacing();
         let step = h / ppc as f64;
         // The lattice: sub-cells of the unpadded grid, or anchored at the
@@ -2483,7 +2470,7 @@ struct ExplicitKeys {
 /// other kind are refused where they are, and the explicit keys are
 /// checked and completed with their defaults (`None` for the implicit
 /// solver).
-fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>, CasesError> {
+fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>, SceneError> {
     let span = |v: &Option<Spanned<f64>>| v.as_ref().map(Spanned::span);
     let explicit_keys = [
         ("end_time", span(&s.end_time)),
@@ -2503,7 +2490,7 @@ fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>
             ));
         }
         if *s.locking.get_ref() == LockingKind::CellAveraged {
-            return Err(src.at(&s.locking, crate::variant::CELL_AVERAGED_IMPLICIT));
+            return Err(src.at(&s.locking, crate::rules::CELL_AVERAGED_IMPLICIT));
         }
         return Ok(None);
     }
@@ -2623,12 +2610,12 @@ fn solver_keys(s: &SolverSpec, src: &SceneSource) -> Result<Option<ExplicitKeys>
 /// number of fixed steps.
 ///
 /// # Errors
-/// [`CasesError::Scene`] at `cfl` or `time_step`.
+/// [`SceneError::Scene`] at `cfl` or `time_step`.
 fn explicit_time_step(
     s: &SolverSpec,
     src: &SceneSource,
     end_time: f64,
-) -> Result<mpm_solver::TimeStep, CasesError> {
+) -> Result<mpm_solver::TimeStep, SceneError> {
     Ok(match (&s.cfl, &s.time_step) {
         (Some(_), Some(dt)) => {
             return Err(src.at(
@@ -2669,12 +2656,12 @@ fn explicit_time_step(
 /// there), 0 for PIC and TPIC, 1 for FLIP and TFLIP.
 ///
 /// # Errors
-/// [`CasesError::Scene`] at `alpha` or `transfer`.
+/// [`SceneError::Scene`] at `alpha` or `transfer`.
 fn blend_alpha(
     s: &SolverSpec,
     src: &SceneSource,
     transfer: TransferKind,
-) -> Result<f64, CasesError> {
+) -> Result<f64, SceneError> {
     Ok(match (transfer, &s.alpha) {
         (TransferKind::Blend, Some(a)) => {
             let alpha = *a.get_ref();
