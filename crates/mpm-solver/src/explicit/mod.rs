@@ -649,7 +649,11 @@ where
             .map(
                 |(task, (x, v, f, vol, tau, mat, tr, mass, vol0, dom, dom0))| {
                     let mut stencil = basis.new_stencil();
-                    let field = DomainField::new(mesh, grid, fixities, dt);
+                    let deformer = Deformer::<D, B, L, R> {
+                        law,
+                        rule,
+                        field: DomainField::new(mesh, grid, fixities, dt),
+                    };
                     let mut signal: f64 = 0.0;
                     for k in 0..x.len() {
                         let point = task * per + k;
@@ -657,36 +661,24 @@ where
                             .map_err(|e| (point, e))?;
                         let x_start = x[k];
                         g2p::move_point(alpha, dt, &g, &mut x[k], &mut v[k]);
-                        let s = g2p::finish::<D, L, T>(
-                            law,
-                            dt,
-                            &g.grad,
-                            None,
-                            PointMut {
-                                f: &mut f[k],
-                                volume: &mut vol[k],
-                                volume0: vol0[k],
-                                tau: &mut tau[k],
-                                material: &mut mat[k],
-                                transfer: &mut tr[k],
-                                mass: mass[k],
-                                velocity: &v[k],
-                            },
-                        )
-                        .map_err(|e| (point, e))?;
-                        if Self::HAS_DOMAIN {
-                            update_domain::<D, B, R>(
-                                rule,
-                                &field,
+                        let s = deformer
+                            .deform::<T>(
                                 &g.grad,
-                                &f[k],
-                                &x_start,
-                                &x[k],
-                                &dom0[k],
-                                &mut dom[k],
+                                None,
+                                PointMut {
+                                    f: &mut f[k],
+                                    volume: &mut vol[k],
+                                    volume0: vol0[k],
+                                    tau: &mut tau[k],
+                                    material: &mut mat[k],
+                                    transfer: &mut tr[k],
+                                    mass: mass[k],
+                                    velocity: &v[k],
+                                },
+                                (&x_start, &x[k]),
+                                (&dom0[k], &mut dom[k]),
                             )
                             .map_err(|e| (point, e))?;
-                        }
                         signal = signal.max(s);
                     }
                     Ok(signal)
@@ -778,7 +770,11 @@ where
             .enumerate()
             .map(
                 |(task, ((f, vol, tau, mat, tr, grads), (cells, v, mass, vol0, dom, dom0, x)))| {
-                    let field = DomainField::new(mesh, grid, fixities, dt);
+                    let deformer = Deformer::<D, B, L, R> {
+                        law,
+                        rule,
+                        field: DomainField::new(mesh, grid, fixities, dt),
+                    };
                     let mut signal: f64 = 0.0;
                     for k in 0..f.len() {
                         let point = task * per + k;
@@ -791,36 +787,24 @@ where
                                 bar[(a, a)] += shift;
                             }
                         }
-                        let s = g2p::finish::<D, L, T>(
-                            law,
-                            dt,
-                            grad,
-                            Some(&bar),
-                            PointMut {
-                                f: &mut f[k],
-                                volume: &mut vol[k],
-                                volume0: vol0[k],
-                                tau: &mut tau[k],
-                                material: &mut mat[k],
-                                transfer: &mut tr[k],
-                                mass: mass[k],
-                                velocity: &v[k],
-                            },
-                        )
-                        .map_err(|e| (point, e))?;
-                        if Self::HAS_DOMAIN {
-                            update_domain::<D, B, R>(
-                                rule,
-                                &field,
+                        let s = deformer
+                            .deform::<T>(
                                 grad,
-                                &f[k],
-                                &starts[point],
-                                &x[k],
-                                &dom0[k],
-                                &mut dom[k],
+                                Some(&bar),
+                                PointMut {
+                                    f: &mut f[k],
+                                    volume: &mut vol[k],
+                                    volume0: vol0[k],
+                                    tau: &mut tau[k],
+                                    material: &mut mat[k],
+                                    transfer: &mut tr[k],
+                                    mass: mass[k],
+                                    velocity: &v[k],
+                                },
+                                (&starts[point], &x[k]),
+                                (&dom0[k], &mut dom[k]),
                             )
                             .map_err(|e| (point, e))?;
-                        }
                         signal = signal.max(s);
                     }
                     Ok(signal)
@@ -880,6 +864,63 @@ where
         })?;
     *domain = updated;
     Ok(())
+}
+
+/// The second half of a point's grid-to-point update, shared by the fused
+/// pass and the cell-averaged one: the stress update with the velocity
+/// gradient (and, under dilatation averaging, its averaged form for the
+/// volume, eq. 52), then the point's domain.
+struct Deformer<'a, const D: usize, B: BasisFunction<D>, L, R> {
+    law: &'a L,
+    rule: &'a R,
+    field: DomainField<'a, D, B::Mesh>,
+}
+
+impl<const D: usize, B, L, R> Deformer<'_, D, B, L, R>
+where
+    B: BasisFunction<D>,
+    B::Mesh: NodalMesh<D>,
+    L: IncrementalLaw,
+    R: DomainUpdater<D, B::Domain>,
+{
+    /// Deforms one point that moved from `positions.0` to `positions.1`;
+    /// `domains` are its initial and current domain. Returns its signal
+    /// speed.
+    #[inline(always)]
+    fn deform<T: Transfer<D>>(
+        &self,
+        grad: &SMatrix<f64, D, D>,
+        bar: Option<&SMatrix<f64, D, D>>,
+        point: PointMut<'_, D, L::State, T::PointState>,
+        positions: (&SVector<f64, D>, &SVector<f64, D>),
+        domains: (&B::Domain, &mut B::Domain),
+    ) -> Result<f64, PointFailure> {
+        let f = point.f;
+        let signal = g2p::finish::<D, L, T>(
+            self.law,
+            self.field.dt,
+            grad,
+            bar,
+            PointMut {
+                f: &mut *f,
+                ..point
+            },
+        )?;
+        if std::mem::size_of::<B::Domain>() > 0 {
+            // The domain follows the unmodified gradient, as F does.
+            update_domain::<D, B, R>(
+                self.rule,
+                &self.field,
+                grad,
+                f,
+                positions.0,
+                positions.1,
+                domains.0,
+                domains.1,
+            )?;
+        }
+        Ok(signal)
+    }
 }
 
 /// What a domain update reads of the grid: one per grid-to-point task.
