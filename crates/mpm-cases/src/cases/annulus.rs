@@ -110,30 +110,32 @@ impl crate::cases::Case for AnnulusCase {
         mut p: AnnulusParams,
         session: &crate::session::Session,
     ) -> Result<(), crate::CasesError> {
-        use crate::session::summary;
         session.resolve(&mut p.mesh);
         let problem = problem(&p, &p.variant())?;
-        let crate::scene::build::SceneMesh::Simplex(mesh) = &problem.mesh else {
-            return Err(SolverError::InvalidInput("the annulus runs on triangles".into()).into());
-        };
-        let (mut obs, control) = session.start(&p, (**mesh).clone())?;
-        let r = run_problem(&p, &problem, &control, |s, rep, snap| {
-            obs.step(s, rep, snap)
-        })?;
-        let mut results = serde_json::Map::new();
-        results.insert("max_error".into(), serde_json::json!(r.max_error));
-        results.insert("elements".into(), serde_json::json!(r.elements));
-        results.insert("element_size".into(), serde_json::json!(r.element_size));
-        let s = summary(
+        let mesh = super::simplices_of(&problem, "the annulus runs on triangles")?;
+        super::run_in_session(
             Self::NAME,
-            p.variant(),
-            r.material_points,
-            &r.output,
-            Some(r.error),
-            results,
             &p,
-        );
-        obs.finish(s)
+            p.variant(),
+            session,
+            mesh,
+            |control, obs| {
+                run_problem(&p, &problem, control, |s, rep, snap| obs.step(s, rep, snap))
+            },
+            |r| super::Measured {
+                output: &r.output,
+                material_points: r.material_points,
+                error: Some(r.error),
+                results: [
+                    ("max_error", serde_json::json!(r.max_error)),
+                    ("elements", serde_json::json!(r.elements)),
+                    ("element_size", serde_json::json!(r.element_size)),
+                ]
+                .into_iter()
+                .map(|(k, v)| (k.to_owned(), v))
+                .collect(),
+            },
+        )
     }
 }
 

@@ -60,42 +60,40 @@ impl crate::cases::Case for CantileverCase {
         p: CantileverParams,
         session: &crate::session::Session,
     ) -> Result<(), crate::CasesError> {
-        use crate::session::{observer_error, summary};
+        use crate::session::observer_error;
         let (problem, loaded) = problem(&p, &p.variant())?;
-        let crate::scene::build::SceneMesh::Grid(grid) = &problem.mesh else {
-            return Err(SolverError::InvalidInput("the cantilever runs on a grid".into()).into());
+        let mesh = super::grid_of(&problem, "the cantilever runs on a grid")?;
+        let step = |control: &_, obs: &mut crate::session::Observer<2, _>| {
+            run_problem(&problem, loaded, control, |s, rep, snap| {
+                // The case table first: the step's checkpoint must hold its row.
+                let (ux, uy) = tip_displacement(snap, loaded);
+                obs.writer
+                    .case_row(
+                        "tip.csv",
+                        &["load_factor", "tip_u_over_l0", "tip_v_over_l0"],
+                        &[
+                            rep.lambda1.into(),
+                            (ux / p.length).into(),
+                            (uy / p.length).into(),
+                        ],
+                    )
+                    .map_err(observer_error)?;
+                obs.step(s, rep, snap)
+            })
         };
-        let (mut obs, control) = session.start(&p, grid.clone())?;
-        let r = run_problem(&problem, loaded, &control, |s, rep, snap| {
-            // The case table first: the step's checkpoint must hold its row.
-            let (ux, uy) = tip_displacement(snap, loaded);
-            obs.writer
-                .case_row(
-                    "tip.csv",
-                    &["load_factor", "tip_u_over_l0", "tip_v_over_l0"],
-                    &[
-                        rep.lambda1.into(),
-                        (ux / p.length).into(),
-                        (uy / p.length).into(),
-                    ],
-                )
-                .map_err(observer_error)?;
-            obs.step(s, rep, snap)
-        })?;
-        let mut results = serde_json::Map::new();
-        if let Some((_, ux, uy)) = r.tip.last() {
-            results.insert("tip_displacement".into(), serde_json::json!([ux, uy]));
-        }
-        let s = summary(
-            Self::NAME,
-            p.variant(),
-            r.material_points,
-            &r.output,
-            None,
-            results,
-            &p,
-        );
-        obs.finish(s)
+        super::run_in_session(Self::NAME, &p, p.variant(), session, mesh, step, |r| {
+            super::Measured {
+                output: &r.output,
+                material_points: r.material_points,
+                error: None,
+                results: r
+                    .tip
+                    .last()
+                    .map(|(_, ux, uy)| ("tip_displacement".to_owned(), serde_json::json!([ux, uy])))
+                    .into_iter()
+                    .collect(),
+            }
+        })
     }
 }
 

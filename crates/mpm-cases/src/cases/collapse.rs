@@ -58,29 +58,28 @@ impl crate::cases::Case for CollapseCase {
     type Params = CollapseParams;
 
     fn run(p: CollapseParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
-        use crate::session::summary;
         let problem = problem(&p, &p.variant())?;
-        let crate::scene::build::SceneMesh::Grid(grid) = &problem.mesh else {
-            return Err(SolverError::InvalidInput("the collapse runs on a grid".into()).into());
-        };
-        let (mut obs, control) = session.start(&p, grid.clone())?;
-        let r = run_problem(&problem, &control, |s, rep, snap| obs.step(s, rep, snap))?;
-        let mut results = serde_json::Map::new();
-        results.insert(
-            "horizontal_extent".into(),
-            serde_json::json!(r.horizontal_extent),
-        );
-        results.insert("max_height".into(), serde_json::json!(r.max_height));
-        let s = summary(
+        let mesh = super::grid_of(&problem, "the collapse runs on a grid")?;
+        super::run_in_session(
             Self::NAME,
-            p.variant(),
-            r.material_points,
-            &r.output,
-            None,
-            results,
             &p,
-        );
-        obs.finish(s)
+            p.variant(),
+            session,
+            mesh,
+            |control, obs| run_problem(&problem, control, |s, rep, snap| obs.step(s, rep, snap)),
+            |r| super::Measured {
+                output: &r.output,
+                material_points: r.material_points,
+                error: None,
+                results: [
+                    ("horizontal_extent", r.horizontal_extent),
+                    ("max_height", r.max_height),
+                ]
+                .into_iter()
+                .map(|(k, v)| (k.to_owned(), serde_json::json!(v)))
+                .collect(),
+            },
+        )
     }
 }
 

@@ -55,25 +55,24 @@ impl crate::cases::Case for ColumnCase {
     type Params = ColumnParams;
 
     fn run(p: ColumnParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
-        use crate::session::summary;
         let problem = problem(&p, &p.variant())?;
-        let crate::scene::build::SceneMesh::Grid(grid) = &problem.mesh else {
-            return Err(SolverError::InvalidInput("the column runs on a grid".into()).into());
-        };
-        let (mut obs, control) = session.start(&p, grid.clone())?;
-        let r = run_problem(&p, &problem, &control, |s, rep, snap| {
-            obs.step(s, rep, snap)
-        })?;
-        let s = summary(
+        let mesh = super::grid_of(&problem, "the column runs on a grid")?;
+        super::run_in_session(
             Self::NAME,
-            p.variant(),
-            r.material_points,
-            &r.output,
-            Some(r.error),
-            serde_json::Map::new(),
             &p,
-        );
-        obs.finish(s)
+            p.variant(),
+            session,
+            mesh,
+            |control, obs| {
+                run_problem(&p, &problem, control, |s, rep, snap| obs.step(s, rep, snap))
+            },
+            |r| super::Measured {
+                output: &r.output,
+                material_points: r.material_points,
+                error: Some(r.error),
+                results: serde_json::Map::new(),
+            },
+        )
     }
 }
 

@@ -93,6 +93,83 @@ pub fn find(name: &str) -> Option<&'static CaseEntry> {
     ALL.iter().find(|c| c.name == name)
 }
 
+/// What a case measured of its run, for `summary.json`.
+pub(crate) struct Measured<'a, const D: usize> {
+    /// The run.
+    pub output: &'a crate::run::RunOutput<D>,
+    /// Number of material points.
+    pub material_points: usize,
+    /// The error against the reference, if the case has one.
+    pub error: Option<f64>,
+    /// Further results, by name.
+    pub results: serde_json::Map<String, serde_json::Value>,
+}
+
+/// The part of [`Case::run`] every case shares: start the session's
+/// outputs on `mesh`, `run` with its control and observer, and finish with
+/// the summary of what `measure` reads off the result.
+///
+/// # Errors
+/// The session's, the run's and the outputs' errors.
+pub(crate) fn run_in_session<const D: usize, M, P, R>(
+    case: &str,
+    p: &P,
+    variant: crate::variant::Variant,
+    session: &Session,
+    mesh: M,
+    run: impl FnOnce(
+        &crate::run::RunControl,
+        &mut crate::session::Observer<D, M>,
+    ) -> Result<R, mpm_solver::SolverError>,
+    measure: impl FnOnce(&R) -> Measured<'_, D>,
+) -> Result<(), CasesError>
+where
+    M: crate::output::CellMesh<D>,
+    P: Serialize,
+{
+    let (mut observer, control) = session.start(p, mesh)?;
+    let result = run(&control, &mut observer)?;
+    let m = measure(&result);
+    let summary = crate::session::summary(
+        case,
+        variant,
+        m.material_points,
+        m.output,
+        m.error,
+        m.results,
+        p,
+    );
+    observer.finish(summary)
+}
+
+/// The regular grid of a case's problem, or `what` (e.g. "the column runs
+/// on a grid") when the scene built another mesh.
+pub(crate) fn grid_of<const D: usize>(
+    problem: &crate::scene::Problem<D>,
+    what: &str,
+) -> Result<mpm_mesh::RegularGrid<D>, mpm_solver::SolverError> {
+    match &problem.mesh {
+        crate::scene::build::SceneMesh::Grid(grid) => Ok(grid.clone()),
+        crate::scene::build::SceneMesh::Simplex(_) => {
+            Err(mpm_solver::SolverError::InvalidInput(what.into()))
+        }
+    }
+}
+
+/// The simplex mesh of a case's problem, or `what` when the scene built a
+/// grid.
+pub(crate) fn simplices_of<const D: usize>(
+    problem: &crate::scene::Problem<D>,
+    what: &str,
+) -> Result<mpm_mesh::SimplexMesh<D>, mpm_solver::SolverError> {
+    match &problem.mesh {
+        crate::scene::build::SceneMesh::Simplex(mesh) => Ok((**mesh).clone()),
+        crate::scene::build::SceneMesh::Grid(_) => {
+            Err(mpm_solver::SolverError::InvalidInput(what.into()))
+        }
+    }
+}
+
 /// The `[solver]` section of a case's scene: the variant, the number of
 /// equal steps and the Newton tolerance.
 pub(crate) fn solver_section(

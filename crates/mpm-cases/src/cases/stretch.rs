@@ -89,35 +89,34 @@ impl crate::cases::Case for StretchCase {
         mut p: StretchParams,
         session: &crate::session::Session,
     ) -> Result<(), crate::CasesError> {
-        use crate::session::summary;
         session.resolve(&mut p.mesh);
         let problem = problem(&p, &p.variant())?;
-        let crate::scene::build::SceneMesh::Simplex(mesh) = &problem.mesh else {
-            return Err(SolverError::InvalidInput("the stretch runs on tetrahedra".into()).into());
-        };
-        let (mut obs, control) = session.start(&p, (**mesh).clone())?;
-        let r = run_problem(&p, &problem, &control, |s, rep, snap| {
-            obs.step(s, rep, snap)
-        })?;
-        let mut results = serde_json::Map::new();
-        results.insert(
-            "analytic_stress".into(),
-            serde_json::json!(r.analytic_stress),
-        );
-        results.insert("tau_yy_mean".into(), serde_json::json!(r.tau_yy.0));
-        results.insert("tau_yy_min".into(), serde_json::json!(r.tau_yy.1));
-        results.insert("tau_yy_max".into(), serde_json::json!(r.tau_yy.2));
-        results.insert("elements".into(), serde_json::json!(r.elements));
-        let s = summary(
+        let mesh = super::simplices_of(&problem, "the stretch runs on tetrahedra")?;
+        super::run_in_session(
             Self::NAME,
-            p.variant(),
-            r.material_points,
-            &r.output,
-            Some(r.error),
-            results,
             &p,
-        );
-        obs.finish(s)
+            p.variant(),
+            session,
+            mesh,
+            |control, obs| {
+                run_problem(&p, &problem, control, |s, rep, snap| obs.step(s, rep, snap))
+            },
+            |r| super::Measured {
+                output: &r.output,
+                material_points: r.material_points,
+                error: Some(r.error),
+                results: [
+                    ("analytic_stress", serde_json::json!(r.analytic_stress)),
+                    ("tau_yy_mean", serde_json::json!(r.tau_yy.0)),
+                    ("tau_yy_min", serde_json::json!(r.tau_yy.1)),
+                    ("tau_yy_max", serde_json::json!(r.tau_yy.2)),
+                    ("elements", serde_json::json!(r.elements)),
+                ]
+                .into_iter()
+                .map(|(k, v)| (k.to_owned(), v))
+                .collect(),
+            },
+        )
     }
 }
 
