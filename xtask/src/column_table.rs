@@ -17,6 +17,7 @@ use crate::write_file;
 
 /// Measures the table and writes it under `docs`.
 pub fn run(docs: &Path) -> Result<()> {
+    let start = std::time::Instant::now();
     let mut md = String::new();
     writeln!(md, "# Column: error against run time\n")?;
     writeln!(
@@ -24,9 +25,12 @@ pub fn run(docs: &Path) -> Result<()> {
         "Compaction under self weight (Coombs et al. 2020 §7.1): error of eq. (42) and solver wall time\n\
          (fastest of at least {REPEATS} runs, file output excluded) for h = 50/2^k, 2×2 points per cell, 20 load steps,\n\
          tolerance 1e-9, previously converged formulation. Regenerate with\n\
-         `cargo run --release -p xtask -- column-table` (2-core machine). Every GIMP domain\n\
+         `cargo run --release -p xtask -- column-table` (on {} (UTC), {}; it took {}). Every GIMP domain\n\
          update, CPDI2 and the quadratic B-spline are compared in\n\
-         [the Coombs et al. (2020) reproduction](../reproduction/coombs2020.md).\n"
+         [the Coombs et al. (2020) reproduction](../reproduction/coombs2020.md).\n",
+        crate::machine::today(),
+        crate::machine::description(),
+        crate::machine::TOOK,
     )?;
     writeln!(
         md,
@@ -51,7 +55,7 @@ pub fn run(docs: &Path) -> Result<()> {
         writeln!(md, "{row}")?;
     }
     let path = docs.join("benchmarks/column.md");
-    write_file(&path, md)?;
+    write_file(&path, crate::machine::stamp_duration(md, start))?;
     println!("wrote {}", path.display());
     Ok(())
 }

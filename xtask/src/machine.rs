@@ -1,6 +1,16 @@
 //! What a report says about where and when it was measured.
 
-use std::time::{SystemTime, UNIX_EPOCH};
+use std::time::{Instant, SystemTime, UNIX_EPOCH};
+
+/// Where a page's header says how long its command took: replaced by
+/// [`stamp_duration`] once the page is complete.
+pub const TOOK: &str = "{took}";
+
+/// `page` with [`TOOK`] replaced by the wall time since `start` (so every
+/// generated page names its command and how long it took).
+pub fn stamp_duration(page: String, start: Instant) -> String {
+    page.replace(TOOK, &format!("{:.0} s", start.elapsed().as_secs_f64()))
+}
 
 /// Today's date (UTC) as `YYYY-MM-DD`.
 pub fn today() -> String {
