@@ -124,6 +124,48 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             &StepContext<'_, P::Mesh>,
         ) -> Result<(), SolverError>,
     {
+        let mut control = StepControl::new(stepping, state)?;
+        while let Some((lambda, target)) = control.next_step() {
+            match self.solve_load_step(points, lambda, target) {
+                Ok(report) => {
+                    let (step, report) = control.converged(report);
+                    let context = StepContext {
+                        state: control.state(),
+                        predictor: self.predictor_state(),
+                        mesh: &self.mesh,
+                        stiffness: self.free_stiffness(),
+                    };
+                    observer(step, &report, points, &context)?;
+                }
+                Err(e) => control.failed(e)?,
+            }
+        }
+        Ok(control.state().summary)
+    }
+}
+
+/// The automatic step control of a run, apart from the solver: which step
+/// to try next, what a converged or failed step changes, when to give
+/// up. Compiled once per dimension, whatever solver it drives.
+#[derive(Debug)]
+pub struct StepControl {
+    stepping: LoadStepping,
+    summary: RunSummary,
+    lambda: f64,
+    increment: f64,
+    /// The failed attempts since the last converged step.
+    cuts: Vec<CutStep>,
+    /// The target of the step being tried.
+    target: f64,
+}
+
+impl StepControl {
+    /// Continues a run from `state` with `stepping`.
+    ///
+    /// # Errors
+    /// [`SolverError::InvalidInput`] for increments out of order or below
+    /// [`MIN_LOAD_INCREMENT`], or a state that cannot be resumed.
+    pub fn new(stepping: &LoadStepping, state: RunState) -> Result<Self, SolverError> {
         if !(stepping.min >= MIN_LOAD_INCREMENT
             && stepping.min <= stepping.initial
             && stepping.initial <= stepping.max)
@@ -140,69 +182,91 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 "cannot resume from {state:?}: need 0 <= load factor <= 1 and a positive increment"
             )));
         }
-        let mut summary = state.summary;
-        let mut lambda = state.load_factor;
-        let mut increment = state.increment.min(stepping.max);
+        Ok(Self {
+            stepping: *stepping,
+            summary: state.summary,
+            lambda: state.load_factor,
+            increment: state.increment.min(stepping.max),
+            cuts: Vec::new(),
+            target: state.load_factor,
+        })
+    }
+
+    /// The load factors from and to which the next step goes, or `None`
+    /// when the run has reached 1.
+    pub fn next_step(&mut self) -> Option<(f64, f64)> {
         const END: f64 = 1.0 - 1e-12;
-        let mut cuts = Vec::new();
-        while lambda < END {
-            let target = (lambda + increment).min(1.0);
-            match self.solve_load_step(points, lambda, target) {
-                Ok(mut report) => {
-                    report.cuts = std::mem::take(&mut cuts);
-                    summary.steps += 1;
-                    summary.iterations += report.iterations();
-                    lambda = target;
-                    increment = (2.0 * increment).min(stepping.max);
-                    let now = RunState {
-                        load_factor: lambda,
-                        increment,
-                        summary,
-                    };
-                    let context = StepContext {
-                        state: now,
-                        predictor: self.predictor_state(),
-                        mesh: &self.mesh,
-                        stiffness: self.free_stiffness(),
-                    };
-                    observer(summary.steps - 1, &report, points, &context)?;
-                }
-                Err(StepError::Fatal(e)) => {
-                    return Err(SolverError::InStep {
-                        step: summary.steps,
-                        load_factor: lambda,
-                        target,
-                        source: Box::new(e),
-                    });
-                }
-                Err(StepError::Retry {
-                    cause,
-                    last_residual,
-                }) => {
-                    summary.cut_steps += 1;
-                    let tried = target - lambda;
-                    increment = 0.5 * tried;
-                    if increment >= stepping.min {
-                        cuts.push(CutStep {
-                            lambda0: lambda,
-                            target,
-                            last_residual,
-                            cause,
-                        });
-                    } else {
-                        return Err(SolverError::StepTooSmall {
-                            step: summary.steps,
-                            load_factor: lambda,
-                            target,
-                            increment: tried,
-                            min_increment: stepping.min,
-                            last_residual,
-                            cause,
-                        });
-                    }
-                }
+        (self.lambda < END).then(|| {
+            self.target = (self.lambda + self.increment).min(1.0);
+            (self.lambda, self.target)
+        })
+    }
+
+    /// Accepts the converged step: its number and its report with the
+    /// cuts that preceded it; the increment doubles up to the maximum.
+    pub fn converged<const D: usize>(
+        &mut self,
+        mut report: StepReport<D>,
+    ) -> (usize, StepReport<D>) {
+        report.cuts = std::mem::take(&mut self.cuts);
+        self.summary.steps += 1;
+        self.summary.iterations += report.iterations();
+        self.lambda = self.target;
+        self.increment = (2.0 * self.increment).min(self.stepping.max);
+        (self.summary.steps - 1, report)
+    }
+
+    /// Records the failed step: the increment halves.
+    ///
+    /// # Errors
+    /// [`SolverError::InStep`] for a fatal failure,
+    /// [`SolverError::StepTooSmall`] when the halved increment falls below
+    /// the minimum.
+    pub fn failed(&mut self, error: StepError) -> Result<(), SolverError> {
+        let (lambda, target) = (self.lambda, self.target);
+        let (cause, last_residual) = match error {
+            StepError::Fatal(e) => {
+                return Err(SolverError::InStep {
+                    step: self.summary.steps,
+                    load_factor: lambda,
+                    target,
+                    source: Box::new(e),
+                });
             }
+            StepError::Retry {
+                cause,
+                last_residual,
+            } => (cause, last_residual),
+        };
+        self.summary.cut_steps += 1;
+        let tried = target - lambda;
+        self.increment = 0.5 * tried;
+        if self.increment < self.stepping.min {
+            return Err(SolverError::StepTooSmall {
+                step: self.summary.steps,
+                load_factor: lambda,
+                target,
+                increment: tried,
+                min_increment: self.stepping.min,
+                last_residual,
+                cause,
+            });
         }
-        Ok(summary)
+        self.cuts.push(CutStep {
+            lambda0: lambda,
+            target,
+            last_residual,
+            cause,
+        });
+        Ok(())
+    }
+
+    /// Where the run stands: the state to resume from.
+    pub fn state(&self) -> RunState {
+        RunState {
+            load_factor: self.lambda,
+            increment: self.increment,
+            summary: self.summary,
+        }
     }
 }

@@ -2,8 +2,10 @@
 //! (Coombs et al. 2020 §6.3; the algorithm of AMPLE, Coombs & Augarde 2020).
 //!
 //! One load step, [`ImplicitSolver::solve_load_step`], is the paper's
-//! algorithm, each stage a method of [`stages`](self::stages) that calls
-//! the reusable functions of [`crate::stages`]:
+//! algorithm, written once per dimension in [`driver`] over the
+//! object-safe [`driver::NewtonStages`]; each stage is a method of
+//! [`stages`](self::stages) that calls the reusable functions of
+//! [`crate::stages`]:
 //!
 //! 1. [`evaluate_basis`](ImplicitSolver::evaluate_basis): basis values and
 //!    gradients at the start of the step, once per step;
@@ -38,6 +40,7 @@
 //! benchmarks).
 
 pub mod builder;
+pub mod driver;
 pub mod options;
 mod predictor;
 pub mod report;
@@ -51,17 +54,9 @@ pub use report::{CutStep, FreeStiffness, StageTimes, StepError, StepReport};
 use mpm_constitutive::Response;
 use nalgebra::{Matrix3, SVector};
 
-use crate::error::StepFailure;
 use crate::linear::LinearSolver;
-use std::time::Instant;
-
-/// Seconds since `clock`.
-fn lap(clock: Instant) -> f64 {
-    clock.elapsed().as_secs_f64()
-}
-use crate::locking::LockingTreatment;
 use crate::parts::{PointsOf, SolverParts};
-use crate::stages::convergence::{self, NewtonMonitor, Verdict};
+use crate::stages::convergence;
 use crate::stages::gather::{PointStress, PointTangent};
 use crate::stages::ghost::GhostFaces;
 use crate::stages::patch::PatchSystem;
@@ -211,137 +206,11 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         lambda0: f64,
         lambda1: f64,
     ) -> Result<StepReport<D>, StepError> {
-        let mut times = StageTimes::default();
-        let clock = Instant::now();
-        self.move_mesh(lambda0)?;
-        self.evaluate_basis(points)?;
-        times.basis = lap(clock);
-        let clock = Instant::now();
-        self.begin_constraints(points);
-        self.build_system(points, lambda0, lambda1)?;
-        self.assemble_external_force(points, lambda1);
-        times.system = lap(clock);
-        let mut linear_iterations = 0;
-        let predicted = self.predict(lambda1 - lambda0);
-        // The first solve linearises about the converged state when the
-        // step starts from prescribed increments alone (FirstTangent).
-        let linearised_start = self.options.first_tangent == FirstTangent::Converged
-            && !predicted
-            && self.it.du.iter().any(|&u| u != 0.0);
-        if linearised_start {
-            let clock = Instant::now();
-            self.linearised_start(points)
-                .map_err(|cause| StepError::Retry {
-                    cause,
-                    last_residual: f64::NAN,
-                })?;
-            times.solve += lap(clock);
-            linear_iterations += self.linear.last_iterations();
-        }
-        let o = &self.options;
-        let mut monitor = NewtonMonitor::new(o.tolerance, o.divergence_factor, o.max_iterations)
-            .with_rounding_floor(o.rounding_floor_factor)
-            .expecting_first_correction(!self.first_iterate_converged);
-        let mut backtracked = Vec::new();
-        let mut initial_unbalance = None;
-        let retry = |cause, monitor: &NewtonMonitor| StepError::Retry {
-            cause,
-            last_residual: monitor.last(),
+        let mut bound = driver::Bound {
+            solver: self,
+            points,
         };
-        let mut fused_updates = 0;
-        // Whether the converged iterate's fused tangents went unused.
-        let unused_tangents = loop {
-            let iteration = monitor.iteration();
-            // The first iteration's tangents also give the rounding noise.
-            let first = iteration == 0;
-            // Where Newton expects to correct this iterate, its tangents
-            // come with the update (a coupled treatment gains nothing: it
-            // keeps the responses for its patch terms).
-            let fused = !self.locking.couples_points() && monitor.expects_correction();
-            fused_updates += usize::from(fused);
-            let clock = Instant::now();
-            match self.update_material_points_backtracking(
-                points,
-                iteration > 0,
-                fused.then_some(first),
-            ) {
-                Ok(true) => backtracked.push(iteration),
-                Ok(false) => {}
-                Err(cause) => return Err(retry(cause, &monitor)),
-            }
-            times.material += lap(clock);
-            let clock = Instant::now();
-            if fused {
-                // The stiffness is known before the test as well.
-                self.assemble_internal_force_and_stiffness();
-                times.stiffness += lap(clock);
-            } else {
-                self.assemble_internal_force();
-                times.force += lap(clock);
-            }
-            if iteration == 0 {
-                initial_unbalance = convergence::unbalance_all_dofs(&self.it.f_int, &self.it.f_ext);
-            }
-            let (r, d) = convergence::residual_parts(&self.system, &self.it.f_int, &self.it.f_ext);
-            match monitor.check(r, d) {
-                Verdict::Converged => break fused,
-                Verdict::Failed(cause) => return Err(retry(cause, &monitor)),
-                Verdict::Continue => {}
-            }
-            let clock = Instant::now();
-            if !fused {
-                self.update_tangents_with(points, false, first)
-                    .map_err(|cause| retry(cause, &monitor))?;
-            }
-            if first {
-                monitor.set_rounding_noise(convergence::rounding_noise(
-                    &self.system,
-                    self.force_gradients(),
-                    &self.it.tangent_norms,
-                ));
-            }
-            times.tangent += lap(clock);
-            if !fused {
-                let clock = Instant::now();
-                self.assemble_stiffness();
-                times.stiffness += lap(clock);
-            }
-            let clock = Instant::now();
-            self.solve()
-                .map_err(|source| retry(StepFailure::LinearSolve { source }, &monitor))?;
-            times.solve += lap(clock);
-            linear_iterations += self.linear.last_iterations();
-        };
-        self.first_iterate_converged = monitor.iteration() == 1;
-        let clock = Instant::now();
-        let reaction = convergence::reaction(&self.system, &self.it.f_int, &self.it.f_ext);
-        let node_reactions =
-            convergence::node_reactions(&self.system, &self.it.f_int, &self.it.f_ext);
-        self.commit(points)?;
-        // The mesh follows to the end of the step, with the points.
-        self.move_mesh(lambda1)?;
-        self.remember_increment(lambda1 - lambda0);
-        times.commit = lap(clock);
-        Ok(StepReport {
-            lambda0,
-            lambda1,
-            rounding_floor: monitor.rounding_floor(),
-            at_rounding_floor: monitor.at_rounding_floor(),
-            residuals: monitor.into_residuals(),
-            initial_unbalance,
-            reaction,
-            node_reactions,
-            active_nodes: self.system.n_active(),
-            free_dofs: self.system.n_free,
-            factorisation: self.linear.last_factorisation(),
-            backtracked,
-            linearised_start,
-            fused_updates,
-            unused_tangents,
-            times,
-            linear_iterations,
-            cuts: Vec::new(),
-        })
+        driver::solve_load_step(&mut bound, lambda0, lambda1)
     }
 
     /// Normalised out-of-balance force (eq. 40):
