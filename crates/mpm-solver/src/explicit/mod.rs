@@ -90,6 +90,42 @@ pub struct ExplicitStageTimes {
     pub g2p: f64,
 }
 
+/// A stage of an explicit step, as [`ExplicitStageTimes`] reports it.
+#[derive(Debug, Clone, Copy)]
+enum Stage {
+    P2g,
+    Grid,
+    G2p,
+}
+
+/// The wall time of the stages of one step.
+#[derive(Debug, Default)]
+struct StageClock {
+    times: ExplicitStageTimes,
+}
+
+impl StageClock {
+    /// Runs `f`, adding its wall time to `stage`.
+    fn time<R>(&mut self, stage: Stage, f: impl FnOnce() -> R) -> R {
+        let start = std::time::Instant::now();
+        let out = f();
+        let t = &mut self.times;
+        *match stage {
+            Stage::P2g => &mut t.p2g,
+            Stage::Grid => &mut t.grid,
+            Stage::G2p => &mut t.g2p,
+        } += start.elapsed().as_secs_f64();
+        out
+    }
+
+    /// Adds the step's times to the solver's.
+    fn add_to(&self, total: &mut ExplicitStageTimes) {
+        total.p2g += self.times.p2g;
+        total.grid += self.times.grid;
+        total.g2p += self.times.g2p;
+    }
+}
+
 /// One point's state as the end of the grid-to-point stage updates it.
 #[derive(Debug)]
 pub struct PointMut<'a, const D: usize, S, T> {
@@ -405,6 +441,40 @@ where
         points: &mut PointsOf<D, B, L, T>,
         max_dt: f64,
     ) -> Result<StepInfo, SolverError> {
+        let dt = self.admissible_increment(points, max_dt)?;
+        self.hold_fixed_points(points)?;
+        let mut clock = StageClock::default();
+        clock
+            .time(Stage::P2g, || self.point_to_grid(points))
+            .map_err(|e| self.point_failure(e))?;
+        clock
+            .time(Stage::Grid, || self.update_grid(points, dt))
+            .map_err(|e| self.point_failure(e))?;
+        let work = self.point_force_power(points);
+        let signal = clock
+            .time(Stage::G2p, || self.gather(points, dt))
+            .map_err(|e| self.point_failure(e))?;
+        self.move_fixed_points(points, dt);
+        clock.add_to(&mut self.stage_times);
+        self.external_work += 0.5 * dt * (work + self.point_force_power(points));
+        self.max_signal = Some(signal);
+        self.steps += 1;
+        self.time += dt;
+        Ok(StepInfo {
+            step: self.steps,
+            dt,
+            time: self.time,
+        })
+    }
+
+    /// The step's increment: `max_dt` or the solver's, whichever is
+    /// smaller, refused when it is not positive and finite or exceeds the
+    /// stable increment of eq. (45); the points' domains checked.
+    fn admissible_increment(
+        &mut self,
+        points: &PointsOf<D, B, L, T>,
+        max_dt: f64,
+    ) -> Result<f64, SolverError> {
         let dt = self.time_increment(points).min(max_dt);
         if !(dt.is_finite() && dt > 0.0) {
             return Err(SolverError::InvalidInput(format!(
@@ -422,13 +492,6 @@ where
                 limit: stable,
             });
         }
-        let fail =
-            |this: &Self, (point, reason): (usize, PointFailure)| SolverError::ExplicitPoint {
-                step: this.steps + 1,
-                time: this.time,
-                point,
-                reason,
-            };
         if points.domain.len() != points.len() || points.domain0.len() != points.len() {
             return Err(SolverError::InvalidInput(format!(
                 "{} points but {} domains and {} initial domains",
@@ -437,39 +500,53 @@ where
                 points.domain0.len()
             )));
         }
-        self.hold_fixed_points(points)?;
-        let clock = std::time::Instant::now();
-        self.point_to_grid(points).map_err(|e| fail(self, e))?;
-        let scattered = clock.elapsed().as_secs_f64();
+        Ok(dt)
+    }
+
+    /// The error of a point that failed in the step being taken.
+    fn point_failure(&self, (point, reason): (usize, PointFailure)) -> SolverError {
+        SolverError::ExplicitPoint {
+            step: self.steps + 1,
+            time: self.time,
+            point,
+            reason,
+        }
+    }
+
+    /// The grid update (eq. 32) and the fixed points' velocities held on
+    /// the grid.
+    fn update_grid(
+        &mut self,
+        points: &PointsOf<D, B, L, T>,
+        dt: f64,
+    ) -> Result<(), (usize, PointFailure)> {
         grid_update::update(&self.buffers, &mut self.grid, dt, &self.fixities);
         if !points.fixed_velocity.is_empty() {
-            self.hold_on_grid(points).map_err(|e| fail(self, e))?;
+            self.hold_on_grid(points)?;
         }
-        let updated = clock.elapsed().as_secs_f64();
-        let work = self.point_force_power(points);
-        let signal = if K::AVERAGES {
+        Ok(())
+    }
+
+    /// Grid to point, with the dilatation averaging when the treatment
+    /// asks for it; the largest signal speed.
+    fn gather(
+        &mut self,
+        points: &mut PointsOf<D, B, L, T>,
+        dt: f64,
+    ) -> Result<f64, (usize, PointFailure)> {
+        if K::AVERAGES {
             self.grid_to_point_averaged(points, dt)
         } else {
             self.grid_to_point(points, dt)
         }
-        .map_err(|e| fail(self, e))?;
-        let gathered = clock.elapsed().as_secs_f64();
+    }
+
+    /// Points with prescribed velocity components move with them.
+    fn move_fixed_points(&self, points: &mut PointsOf<D, B, L, T>, dt: f64) {
         for (k, &(p, c, v)) in points.fixed_velocity.iter().enumerate() {
             points.velocity[p][c] = v;
             points.position[p][c] = self.fixed_start[k] + dt * v;
         }
-        self.stage_times.p2g += scattered;
-        self.stage_times.grid += updated - scattered;
-        self.stage_times.g2p += gathered - updated;
-        self.external_work += 0.5 * dt * (work + self.point_force_power(points));
-        self.max_signal = Some(signal);
-        self.steps += 1;
-        self.time += dt;
-        Ok(StepInfo {
-            step: self.steps,
-            dt,
-            time: self.time,
-        })
     }
 
     /// Steps until `end_time`, calling `observer` after every step (it may
@@ -801,7 +878,9 @@ where
                                     mass: mass[k],
                                     velocity: &v[k],
                                 },
-                                (&starts[point], &x[k]),
+                                // The start is kept only for bases with
+                                // domains (none to update otherwise).
+                                (starts.get(point).unwrap_or(&x[k]), &x[k]),
                                 (&dom0[k], &mut dom[k]),
                             )
                             .map_err(|e| (point, e))?;
