@@ -10,7 +10,9 @@
 //! `domain_update` rule chosen at run time, and `cpdi2` with its convected
 //! corners) × transfer (`FlipPic`, which covers PIC, FLIP and their blend;
 //! `Taylor`) × dilatation (`NoLocking`, `CellAveraged`): 20 solvers per
-//! dimension. The materials are a run-time value ([`ExplicitLaws`]: the
+//! dimension; the time loop with its outputs and checkpoints is compiled
+//! once per dimension over the object-safe `Stepper` those solvers
+//! implement. The materials are a run-time value ([`ExplicitLaws`]: the
 //! law chosen per point, each point tagged with its material); a basis
 //! without domains stores none.
 //!
@@ -310,8 +312,8 @@ impl<const D: usize> Run<'_, '_, D> {
         }
     }
 
-    /// Runs with every type chosen: the points, the start (or the resumed
-    /// checkpoint), the steps between outputs, the summary.
+    /// Runs with every type chosen: the solver and its points, handed to
+    /// the time loop ([`time_loop`], compiled once per dimension).
     fn with<B, R, L, T, K>(
         self,
         basis: B,
@@ -335,7 +337,7 @@ impl<const D: usize> Run<'_, '_, D> {
             time_step: setup.time_step,
             gravity: setup.gravity,
         };
-        let mut solver = ExplicitSolver::new(
+        let solver = ExplicitSolver::new(
             basis,
             grid.clone(),
             law,
@@ -345,65 +347,177 @@ impl<const D: usize> Run<'_, '_, D> {
             options,
         )?
         .with_domain_update(rule);
-        let mut points = initial_points::<D, B, L, T>(self.problem, setup)?;
-        let outputs = output_count(setup.end_time, setup.output_interval);
-        let output_time = |k: usize| {
-            if k >= outputs {
-                setup.end_time
-            } else {
-                k as f64 * setup.output_interval
-            }
-        };
-        let reached = |solver: &ExplicitSolver<D, B, L, T, K, R>, points: &PointsOf<D, B, L, T>| {
-            Ok::<_, SolverError>(Reached {
-                time: solver.time(),
-                steps: solver.steps(),
-                energies: solver.energies(points)?,
-                external_work: solver.external_work(),
-            })
-        };
-        let mut wall = Wall::default();
-        let mut run = Outputs {
-            initial_position: &self.problem.position,
-            control: self.control,
-            observer: self.observer,
-        };
-        let mut clock = match &self.control.resume {
-            Some(c) => {
-                let (resumed, clock) = resume(&mut solver, points, c, &mut wall)?;
-                points = resumed;
-                clock
-            }
-            None => run.start(&points, solver.energies(&points)?, &mut wall)?,
-        };
-        let session_start = *solver.stage_times();
-        while clock.index < outputs {
-            let target = output_time(clock.index + 1);
-            // As `ExplicitSolver::run_until`, with the curves' forces set
-            // at the start of every step.
-            while solver.time() < target * (1.0 - 1e-12) {
-                scale_timed_forces(&mut points.point_force, setup, solver.time());
-                let info = solver.step(&mut points, target - solver.time())?;
-                wall.observe(|| (run.observer)(ExplicitEvent::Step(info)))?;
-            }
-            run.output(&points, &reached(&solver, &points)?, &mut clock, &mut wall)?;
-        }
-        let mut out = summary(
-            &points,
-            &reached(&solver, &points)?,
-            &clock,
-            &self.problem.position,
-        );
-        out.outputs = outputs + 1;
-        out.wall_time_s = wall.so_far();
-        let stage = solver.stage_times();
-        out.stage_times = ExplicitStageTimes {
-            p2g: stage.p2g - session_start.p2g,
-            grid: stage.grid - session_start.grid,
-            g2p: stage.g2p - session_start.g2p,
-        };
-        Ok(out)
+        let points = initial_points::<D, B, L, T>(self.problem, setup)?;
+        let mut bound = Bound { solver, points };
+        time_loop(&mut bound, self.problem, setup, self.control, self.observer)
     }
+}
+
+/// A composed explicit solver with its points, as the scene's time loop
+/// sees it. Object-safe, so that the loop, its outputs and checkpoints
+/// ([`time_loop`]) are compiled once per dimension; the solver types
+/// differ only behind it.
+trait Stepper<const D: usize> {
+    /// The simulated time reached.
+    fn time(&self) -> f64;
+    /// One step of at most `max_dt`, the loads with a curve set to their
+    /// values at the step's start.
+    fn step(&mut self, setup: &ExplicitSetup<D>, max_dt: f64) -> Result<StepInfo, SolverError>;
+    /// Where the run stands.
+    fn reached(&self) -> Result<Reached, SolverError>;
+    /// The energies now.
+    fn energies(&self) -> Result<Energies, SolverError>;
+    /// The points as plain arrays at `time`, displacements from
+    /// `initial`.
+    fn snapshot(&self, initial: &[SVector<f64, D>], time: f64) -> Snapshot;
+    /// The points' evolving state as numbers ([`write_points`]).
+    fn flat_points(&self) -> Vec<f64>;
+    /// The points of checkpoint `c` (whose clock is `clock`), the solver
+    /// set to its time.
+    fn resume(&mut self, c: &Checkpoint, clock: &Clock) -> Result<(), SolverError>;
+    /// Wall time per stage so far.
+    fn stage_times(&self) -> ExplicitStageTimes;
+}
+
+/// A typed solver with its points: the [`Stepper`] of one solver type.
+struct Bound<const D: usize, B, L, T, K, R>
+where
+    B: BasisFunction<D>,
+    L: IncrementalLaw,
+    T: Transfer<D>,
+{
+    solver: ExplicitSolver<D, B, L, T, K, R>,
+    points: PointsOf<D, B, L, T>,
+}
+
+impl<const D: usize, B, L, T, K, R> Stepper<D> for Bound<D, B, L, T, K, R>
+where
+    B: BasisFunction<D, Mesh = RegularGrid<D>>,
+    B::Domain: Flat + DomainBounds<D>,
+    R: DomainUpdater<D, B::Domain>,
+    L: IncrementalLaw,
+    L::State: FlatState,
+    T: Transfer<D>,
+    T::PointState: FlatState,
+    K: DilatationTreatment,
+{
+    fn time(&self) -> f64 {
+        self.solver.time()
+    }
+
+    fn step(&mut self, setup: &ExplicitSetup<D>, max_dt: f64) -> Result<StepInfo, SolverError> {
+        scale_timed_forces(&mut self.points.point_force, setup, self.solver.time());
+        self.solver.step(&mut self.points, max_dt)
+    }
+
+    fn reached(&self) -> Result<Reached, SolverError> {
+        Ok(Reached {
+            time: self.solver.time(),
+            steps: self.solver.steps(),
+            energies: self.solver.energies(&self.points)?,
+            external_work: self.solver.external_work(),
+        })
+    }
+
+    fn energies(&self) -> Result<Energies, SolverError> {
+        self.solver.energies(&self.points)
+    }
+
+    fn snapshot(&self, initial: &[SVector<f64, D>], time: f64) -> Snapshot {
+        snapshot_of(&self.points, initial, time)
+    }
+
+    fn flat_points(&self) -> Vec<f64> {
+        write_points(&self.points)
+    }
+
+    fn resume(&mut self, c: &Checkpoint, clock: &Clock) -> Result<(), SolverError> {
+        let scene_tags: Vec<u32> = self
+            .points
+            .material
+            .iter()
+            .map(FlatState::material)
+            .collect();
+        let points =
+            read_points::<D, L::State, T::PointState, B::Domain>(&c.points, self.points.clone())?;
+        // A tag past the set's end would index no law: the checkpoint must
+        // be of this scene's materials.
+        if let Some(p) = (0..points.len()).find(|&p| points.material[p].material() != scene_tags[p])
+        {
+            return Err(SolverError::InvalidInput(format!(
+                "the checkpoint gives point {p} material {}, the scene material {}",
+                points.material[p].material(),
+                scene_tags[p]
+            )));
+        }
+        self.points = points;
+        self.solver.resume_at(
+            c.state.load_factor,
+            c.state.summary.steps,
+            clock.external_work,
+        );
+        Ok(())
+    }
+
+    fn stage_times(&self) -> ExplicitStageTimes {
+        *self.solver.stage_times()
+    }
+}
+
+/// The scene's time loop, once per dimension: the start (or the resumed
+/// checkpoint), the steps between outputs with the observer shown each,
+/// the outputs, the summary.
+fn time_loop<const D: usize>(
+    run: &mut dyn Stepper<D>,
+    problem: &Problem<D>,
+    setup: &ExplicitSetup<D>,
+    control: &RunControl,
+    observer: &mut ExplicitObserver<'_>,
+) -> Result<ExplicitOutput, SolverError> {
+    let outputs = output_count(setup.end_time, setup.output_interval);
+    let output_time = |k: usize| {
+        if k >= outputs {
+            setup.end_time
+        } else {
+            k as f64 * setup.output_interval
+        }
+    };
+    let mut wall = Wall::default();
+    let mut out = Outputs {
+        initial_position: &problem.position,
+        control,
+        observer,
+    };
+    let mut clock = match &control.resume {
+        Some(c) => {
+            let clock = Clock::from_checkpoint(c)?;
+            run.resume(c, &clock)?;
+            wall.earlier = c.wall_time_s;
+            clock
+        }
+        None => out.start(run, run.energies()?, &mut wall)?,
+    };
+    let session_start = run.stage_times();
+    while clock.index < outputs {
+        let target = output_time(clock.index + 1);
+        // As `ExplicitSolver::run_until`, with the curves' forces set at
+        // the start of every step.
+        while run.time() < target * (1.0 - 1e-12) {
+            let info = run.step(setup, target - run.time())?;
+            wall.observe(|| (out.observer)(ExplicitEvent::Step(info)))?;
+        }
+        out.output(run, &run.reached()?, &mut clock, &mut wall)?;
+    }
+    let mut result = summary(run, &run.reached()?, &clock, &problem.position);
+    result.outputs = outputs + 1;
+    result.wall_time_s = wall.so_far();
+    let stage = run.stage_times();
+    result.stage_times = ExplicitStageTimes {
+        p2g: stage.p2g - session_start.p2g,
+        grid: stage.grid - session_start.grid,
+        g2p: stage.g2p - session_start.g2p,
+    };
+    Ok(result)
 }
 
 /// The scene's points for basis `B`, law `L` and transfer `T`: positions,
@@ -447,44 +561,6 @@ where
     Ok(points)
 }
 
-/// The points and clock of checkpoint `c`, the solver set to its time.
-fn resume<const D: usize, B, L, T, K, R>(
-    solver: &mut ExplicitSolver<D, B, L, T, K, R>,
-    points: PointsOf<D, B, L, T>,
-    c: &Checkpoint,
-    wall: &mut Wall,
-) -> Result<(PointsOf<D, B, L, T>, Clock), SolverError>
-where
-    B: BasisFunction<D, Mesh = RegularGrid<D>>,
-    B::Domain: Flat,
-    L: IncrementalLaw,
-    L::State: FlatState,
-    T: Transfer<D>,
-    T::PointState: FlatState,
-    K: DilatationTreatment,
-    R: DomainUpdater<D, B::Domain>,
-{
-    let clock = Clock::from_checkpoint(c)?;
-    let scene_tags: Vec<u32> = points.material.iter().map(FlatState::material).collect();
-    let points = read_points::<D, L::State, T::PointState, B::Domain>(&c.points, points)?;
-    // A tag past the set's end would index no law: the checkpoint must be
-    // of this scene's materials.
-    if let Some(p) = (0..points.len()).find(|&p| points.material[p].material() != scene_tags[p]) {
-        return Err(SolverError::InvalidInput(format!(
-            "the checkpoint gives point {p} material {}, the scene material {}",
-            points.material[p].material(),
-            scene_tags[p]
-        )));
-    }
-    solver.resume_at(
-        c.state.load_factor,
-        c.state.summary.steps,
-        clock.external_work,
-    );
-    wall.earlier = c.wall_time_s;
-    Ok((points, clock))
-}
-
 /// What the outputs of a run need: the initial positions (displacements),
 /// whether to keep checkpoints, and the caller's observer.
 struct Outputs<'a, 'o, const D: usize> {
@@ -496,9 +572,9 @@ struct Outputs<'a, 'o, const D: usize> {
 impl<const D: usize> Outputs<'_, '_, D> {
     /// Output 0, the initial state with its `energies`, and the clock that
     /// starts from it.
-    fn start<S: FlatState, T: FlatState, Dom: Flat + DomainBounds<D>>(
+    fn start(
         &mut self,
-        points: &ExplicitPoints<D, S, T, Dom>,
+        run: &dyn Stepper<D>,
         energies: Energies,
         wall: &mut Wall,
     ) -> Result<Clock, SolverError> {
@@ -514,15 +590,15 @@ impl<const D: usize> Outputs<'_, '_, D> {
             energies,
             external_work: 0.0,
         };
-        self.frame(points, &at, &clock, wall)?;
+        self.frame(run, &at, &clock, wall)?;
         Ok(clock)
     }
 
     /// The next output, reached at `at`: the clock advanced to it, the
     /// observer shown it.
-    fn output<S: FlatState, T: FlatState, Dom: Flat + DomainBounds<D>>(
+    fn output(
         &mut self,
-        points: &ExplicitPoints<D, S, T, Dom>,
+        run: &dyn Stepper<D>,
         at: &Reached,
         clock: &mut Clock,
         wall: &mut Wall,
@@ -530,14 +606,14 @@ impl<const D: usize> Outputs<'_, '_, D> {
         clock.index += 1;
         clock.external_work = at.external_work;
         clock.scale = clock.scale.max(at.energies.kinetic + at.energies.strain);
-        self.frame(points, at, clock, wall)
+        self.frame(run, at, clock, wall)
     }
 
     /// Shows the observer output `clock.index` (its time excluded from the
     /// solver's wall time).
-    fn frame<S: FlatState, T: FlatState, Dom: Flat + DomainBounds<D>>(
+    fn frame(
         &mut self,
-        points: &ExplicitPoints<D, S, T, Dom>,
+        run: &dyn Stepper<D>,
         at: &Reached,
         clock: &Clock,
         wall: &mut Wall,
@@ -546,7 +622,7 @@ impl<const D: usize> Outputs<'_, '_, D> {
         let (initial, control) = (self.initial_position, self.control);
         let observer = &mut *self.observer;
         wall.observe(|| {
-            let snapshot = snapshot(points, initial, at.time, control, at.steps, clock, so_far);
+            let snapshot = snapshot(run, initial, at.time, control, at.steps, clock, so_far);
             observer(ExplicitEvent::Output(ExplicitFrame {
                 index: clock.index,
                 time: at.time,
@@ -569,8 +645,8 @@ struct Reached {
 
 /// The run's final state at `at` (the caller adds the counts and times of
 /// this session).
-fn summary<const D: usize, S: FlatState, T: FlatState, Dom: DomainBounds<D>>(
-    points: &ExplicitPoints<D, S, T, Dom>,
+fn summary<const D: usize>(
+    run: &dyn Stepper<D>,
     at: &Reached,
     clock: &Clock,
     initial_position: &[SVector<f64, D>],
@@ -578,7 +654,7 @@ fn summary<const D: usize, S: FlatState, T: FlatState, Dom: DomainBounds<D>>(
     let scale = clock.scale;
     let drift = at.energies.total() - clock.initial.total();
     ExplicitOutput {
-        last: snapshot_of(points, initial_position, at.time),
+        last: run.snapshot(initial_position, at.time),
         steps: at.steps,
         time: at.time,
         outputs: 0,
@@ -706,8 +782,8 @@ impl Clock {
 
 /// A snapshot of the points after `steps` steps, with a checkpoint when
 /// the run keeps them.
-fn snapshot<const D: usize, S: FlatState, T: FlatState, Dom: Flat + DomainBounds<D>>(
-    points: &ExplicitPoints<D, S, T, Dom>,
+fn snapshot<const D: usize>(
+    run: &dyn Stepper<D>,
     initial: &[SVector<f64, D>],
     time: f64,
     control: &RunControl,
@@ -715,7 +791,7 @@ fn snapshot<const D: usize, S: FlatState, T: FlatState, Dom: Flat + DomainBounds
     clock: &Clock,
     wall_time_s: f64,
 ) -> Snapshot {
-    let mut snap = snapshot_of(points, initial, time);
+    let mut snap = run.snapshot(initial, time);
     if control.checkpoint {
         snap.checkpoint = Some(Checkpoint {
             state: RunState {
@@ -728,7 +804,7 @@ fn snapshot<const D: usize, S: FlatState, T: FlatState, Dom: Flat + DomainBounds
                 },
             },
             predictor: None,
-            points: write_points(points),
+            points: run.flat_points(),
             wall_time_s,
             case_state: clock.to_case_state(),
         });
