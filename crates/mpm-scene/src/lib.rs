@@ -19,7 +19,7 @@ pub mod format;
 pub mod manufactured;
 pub mod material;
 pub mod region;
-pub mod rules;
+pub use variant::rules;
 pub mod source;
 pub mod variant;
 

@@ -16,6 +16,8 @@ use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
 use crate::body::DomainBounds;
+
+pub mod rules;
 use crate::body::InitialDomain;
 
 macro_rules! named_enum {
@@ -157,7 +159,7 @@ impl DomainUpdateKind {
             Self::Midpoint => GimpRule::Midpoint,
             Self::VolumeCorrectedDiagF => GimpRule::VolumeCorrectedDiagF,
             Self::IncrementalVolumeCorrectedDiagF => GimpRule::IncrementalVolumeCorrectedDiagF,
-            Self::Cpdi2 => return Err(crate::rules::CPDI2_UPDATE_WITH_GIMP.into()),
+            Self::Cpdi2 => return Err(rules::CPDI2_UPDATE_WITH_GIMP.into()),
         })
     }
 }
@@ -222,7 +224,7 @@ impl TransferKind {
     }
 }
 
-pub use crate::rules::CELL_AVERAGED_IMPLICIT;
+pub use rules::CELL_AVERAGED_IMPLICIT;
 
 /// A complete MPM variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -300,7 +302,7 @@ pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
     visitor: V,
 ) -> Result<V::Output, String> {
     variant
-        .check(crate::rules::Context::ImplicitGrid)
+        .check(rules::Context::ImplicitGrid)
         .map_err(|refusal| refusal.message)?;
     dispatch_basis(variant, visitor)
 }

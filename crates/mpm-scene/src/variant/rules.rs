@@ -7,7 +7,7 @@
 //! row of [`RULES`] (and, for a new mesh or solver kind, one field of
 //! [`Context`]).
 
-use crate::variant::{BasisKind, DomainUpdateKind, GimpVolumeKind, LockingKind, Variant};
+use super::{BasisKind, DomainUpdateKind, GimpVolumeKind, LockingKind, Variant};
 
 /// Where a variant is to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
