@@ -334,6 +334,16 @@ pub fn full_section(full: bool, img: &Path) -> Result<String> {
              352,968)"
         },
     )?;
+    md.push_str(&full_table(&curves, t_cyl).render());
+    md.push_str(&full_figures(&curves, t_cyl, img)?);
+    md.push_str(&full_profile(&curves[1])?);
+    md.push_str(&full_reading(&curves, t_cyl));
+    Ok(md)
+}
+
+/// Table of the full vane's runs: sizes, steps, iterations, times,
+/// memory and torques.
+fn full_table(curves: &[Curve], t_cyl: f64) -> Table {
     let mut table = Table::new([
         "method",
         "tetrahedra",
@@ -356,7 +366,7 @@ pub fn full_section(full: bool, img: &Path) -> Result<String> {
             .find(|p| (p.0 - a).abs() < 1e-9)
             .map_or("–".to_owned(), |p| format!("{:.2}", p.1))
     };
-    for c in &curves {
+    for c in curves {
         let solves: usize = c.steps.iter().map(|s| s.0).sum();
         let krylov: usize = c.steps.iter().map(|s| s.2).sum();
         table.row(vec![
@@ -391,9 +401,15 @@ pub fn full_section(full: bool, img: &Path) -> Result<String> {
                 .map_or("–".to_owned(), |p| format!("{:.3}", p.1 / t_cyl)),
         ]);
     }
-    md.push_str(&table.render());
+    table
+}
+
+/// The torque–rotation figure and Fig. 21 (F-patch's time per step and
+/// per iteration).
+fn full_figures(curves: &[Curve], t_cyl: f64, img: &Path) -> Result<String> {
+    let mut md = String::new();
     let series = torque_series(
-        &curves,
+        curves,
         "cylindrical surface (side + lower end)",
         t_cyl,
         FULL.rotation,
@@ -457,7 +473,13 @@ pub fn full_section(full: bool, img: &Path) -> Result<String> {
             "Full vane with F-patch: wall-clock time of each load step and per Newton iteration",
         )?,
     );
-    // Where the time goes.
+    Ok(md)
+}
+
+/// Where F-patch's time goes: the solver's stage times per Newton
+/// iteration.
+fn full_profile(patched: &Curve) -> Result<String> {
+    let mut md = String::new();
     let t = &patched.times;
     let total = t.total();
     let n = patched.iterations.max(1) as f64;
@@ -495,7 +517,6 @@ pub fn full_section(full: bool, img: &Path) -> Result<String> {
         patched.iterations
     )?;
     md.push_str(&profile.render());
-    md.push_str(&full_reading(&curves, t_cyl));
     Ok(md)
 }
 
