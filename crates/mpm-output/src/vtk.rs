@@ -5,8 +5,8 @@
 //! The grid is built from plain slices, so the solver needs no VTK types:
 //!
 //! ```no_run
-//! # fn main() -> Result<(), mpm_cases::OutputError> {
-//! use mpm_cases::output::vtk::{UnstructuredGrid, Values};
+//! # fn main() -> Result<(), mpm_output::OutputError> {
+//! use mpm_output::vtk::{UnstructuredGrid, Values};
 //! let x = [[0.0, 0.0], [1.0, 0.5]]; // 2D positions, written with z = 0
 //! let p = [1.0e3, 2.0e3];
 //! let mut grid = UnstructuredGrid::from_points(&x)?;
