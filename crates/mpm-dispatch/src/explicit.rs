@@ -242,6 +242,28 @@ fn dispatch<const D: usize>(
     }
 }
 
+/// A grid basis of an explicit scene: its point domains are written to
+/// checkpoints and bounded by the grid.
+trait SceneBasis<const D: usize>:
+    BasisFunction<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>
+{
+}
+
+impl<const D: usize, B> SceneBasis<D> for B where
+    B: BasisFunction<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>
+{
+}
+
+/// A law whose point state is written to checkpoints.
+trait FlatLaw: IncrementalLaw<State: FlatState> {}
+
+impl<L: IncrementalLaw<State: FlatState>> FlatLaw for L {}
+
+/// A velocity transfer whose point state is written to checkpoints.
+trait FlatTransfer<const D: usize>: Transfer<D, PointState: FlatState> {}
+
+impl<const D: usize, T: Transfer<D, PointState: FlatState>> FlatTransfer<D> for T {}
+
 struct Run<'a, 'o, const D: usize> {
     problem: &'a Problem<D>,
     control: &'a RunControl,
@@ -253,8 +275,7 @@ impl<const D: usize> Run<'_, '_, D> {
     /// ([`ExplicitLaws`]).
     fn with_basis<B, R>(self, basis: B, rule: R) -> Result<ExplicitOutput, SolverError>
     where
-        B: BasisFunction<D, Mesh = RegularGrid<D>>,
-        B::Domain: Flat + DomainBounds<D>,
+        B: SceneBasis<D>,
         R: DomainUpdater<D, B::Domain>,
     {
         let laws = (self.problem.materials.iter())
@@ -267,11 +288,9 @@ impl<const D: usize> Run<'_, '_, D> {
     /// The transfer.
     fn with_law<B, R, L>(self, basis: B, rule: R, law: L) -> Result<ExplicitOutput, SolverError>
     where
-        B: BasisFunction<D, Mesh = RegularGrid<D>>,
-        B::Domain: Flat + DomainBounds<D>,
+        B: SceneBasis<D>,
         R: DomainUpdater<D, B::Domain>,
-        L: IncrementalLaw,
-        L::State: FlatState,
+        L: FlatLaw,
     {
         let (_, setup) = parts(self.problem)?;
         let alpha = setup.alpha;
@@ -294,13 +313,10 @@ impl<const D: usize> Run<'_, '_, D> {
         transfer: T,
     ) -> Result<ExplicitOutput, SolverError>
     where
-        B: BasisFunction<D, Mesh = RegularGrid<D>>,
-        B::Domain: Flat + DomainBounds<D>,
+        B: SceneBasis<D>,
         R: DomainUpdater<D, B::Domain>,
-        L: IncrementalLaw,
-        L::State: FlatState,
-        T: Transfer<D>,
-        T::PointState: FlatState,
+        L: FlatLaw,
+        T: FlatTransfer<D>,
     {
         let (_, setup) = parts(self.problem)?;
         match setup.locking {
@@ -323,13 +339,10 @@ impl<const D: usize> Run<'_, '_, D> {
         locking: K,
     ) -> Result<ExplicitOutput, SolverError>
     where
-        B: BasisFunction<D, Mesh = RegularGrid<D>>,
-        B::Domain: Flat + DomainBounds<D>,
+        B: SceneBasis<D>,
         R: DomainUpdater<D, B::Domain>,
-        L: IncrementalLaw,
-        L::State: FlatState,
-        T: Transfer<D>,
-        T::PointState: FlatState,
+        L: FlatLaw,
+        T: FlatTransfer<D>,
         K: DilatationTreatment,
     {
         let (grid, setup) = parts(self.problem)?;
@@ -392,13 +405,10 @@ where
 
 impl<const D: usize, B, L, T, K, R> Stepper<D> for Bound<D, B, L, T, K, R>
 where
-    B: BasisFunction<D, Mesh = RegularGrid<D>>,
-    B::Domain: Flat + DomainBounds<D>,
+    B: SceneBasis<D>,
     R: DomainUpdater<D, B::Domain>,
-    L: IncrementalLaw,
-    L::State: FlatState,
-    T: Transfer<D>,
-    T::PointState: FlatState,
+    L: FlatLaw,
+    T: FlatTransfer<D>,
     K: DilatationTreatment,
 {
     fn time(&self) -> f64 {
@@ -530,8 +540,7 @@ fn initial_points<const D: usize, B, L, T>(
 ) -> Result<PointsOf<D, B, L, T>, SolverError>
 where
     B: BasisFunction<D>,
-    L: IncrementalLaw,
-    L::State: FlatState,
+    L: FlatLaw,
     T: Transfer<D>,
 {
     let points: PointsFor<D, L, T> =

@@ -218,13 +218,10 @@ pub fn simulate<const D: usize, B, F, U, L, C, O>(
     observer: O,
 ) -> Result<RunOutput<D>, SolverError>
 where
-    B: InitialDomain<D>,
-    B::Mesh: MovableMesh<D>,
-    B::Domain: Flat + DomainBounds<D>,
+    B: InitialDomain<D, Mesh: MovableMesh<D>, Domain: Flat + DomainBounds<D>>,
     F: Formulation,
     U: DomainUpdater<D, B::Domain>,
-    L: LogStrainLaw,
-    L::History: HistoryOutput + Flat,
+    L: LogStrainLaw<History: HistoryOutput + Flat>,
     C: Constraints<D>,
     O: FnMut(usize, &StepReport<D>, &Snapshot) -> Result<(), SolverError>,
 {
@@ -279,14 +276,11 @@ pub fn simulate_points<const D: usize, B, F, U, K, L, C>(
     observer: &mut StepObserver<'_, D>,
 ) -> Result<RunOutput<D>, SolverError>
 where
-    B: InitialDomain<D>,
-    B::Mesh: MovableMesh<D>,
-    B::Domain: Flat + DomainBounds<D>,
+    B: InitialDomain<D, Mesh: MovableMesh<D>, Domain: Flat + DomainBounds<D>>,
     F: Formulation,
     U: DomainUpdater<D, B::Domain>,
     K: LockingTreatment<D, B::Mesh>,
-    L: LogStrainLaw,
-    L::History: HistoryOutput + Flat,
+    L: LogStrainLaw<History: HistoryOutput + Flat>,
     C: Constraints<D>,
 {
     let setup = analysis;
