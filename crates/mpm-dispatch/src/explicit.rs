@@ -62,23 +62,23 @@
 
 use std::time::Instant;
 
-use mpm_basis::{BasisFunction, BoundaryBSpline, Cpdi2, Gimp, LinearMpm, QuadraticBSpline};
+use mpm_basis::BasisFunction;
 use mpm_constitutive::{IncrementalLaw, MaterialSet, MaterialState, Tagged};
 use mpm_mesh::RegularGrid;
+use mpm_scene::body::InitialDomain;
 use mpm_solver::explicit::{
     DilatationTreatment, Energies, ExplicitStageTimes, PointsFor, PointsOf, StepInfo,
     VelocityGradient,
 };
 use mpm_solver::{
-    AnyGimpRule, CellAveraged, ConvectedCorners, DomainUpdater, ExplicitOptions, ExplicitPoints,
-    ExplicitSolver, Flat, FlipPic, NoLocking, NoUpdate, RunState, RunSummary, SolverError, Taylor,
-    Transfer,
+    CellAveraged, DomainUpdater, ExplicitOptions, ExplicitPoints, ExplicitSolver, Flat, FlipPic,
+    Formulation, NoLocking, RunState, RunSummary, SolverError, Taylor, Transfer,
 };
 use nalgebra::{Matrix3, SVector};
 
 use crate::run::{Checkpoint, DomainBounds, HistoryOutput, RunControl, Snapshot};
 use mpm_scene::rules::Context;
-use mpm_scene::variant::{BasisKind, LockingKind};
+use mpm_scene::variant::{LockingKind, VariantVisitor, dispatch_in};
 
 use crate::explicit_law::{ExplicitLaw, ExplicitLaws};
 use mpm_scene::build::{ExplicitSetup, Problem, SceneMesh};
@@ -221,24 +221,27 @@ fn dispatch<const D: usize>(
     observer: &mut ExplicitObserver<'_>,
 ) -> Result<ExplicitOutput, SolverError> {
     parts(problem)?;
-    (problem.variant)
-        .check(Context::Explicit)
-        .map_err(|refusal| SolverError::InvalidInput(refusal.message))?;
     let run = Run {
         problem,
         control,
         observer,
     };
-    match problem.variant.basis {
-        BasisKind::Linear => run.with_basis(LinearMpm, NoUpdate),
-        BasisKind::BSpline2 => run.with_basis(QuadraticBSpline, NoUpdate),
-        BasisKind::BSpline2Boundary => run.with_basis(BoundaryBSpline, NoUpdate),
-        BasisKind::Gimp => {
-            let rule =
-                (problem.variant.domain_update.gimp_rule()).map_err(SolverError::InvalidInput)?;
-            run.with_basis(Gimp, AnyGimpRule::new(rule))
-        }
-        BasisKind::Cpdi2 => run.with_basis(Cpdi2, ConvectedCorners),
+    dispatch_in(&problem.variant, Context::Explicit, run).map_err(SolverError::InvalidInput)?
+}
+
+impl<const D: usize> VariantVisitor<D> for Run<'_, '_, D> {
+    type Output = Result<ExplicitOutput, SolverError>;
+
+    /// The basis and its domain rule (`NoUpdate`, `AnyGimpRule` with the
+    /// `det F` volume, `ConvectedCorners`); the formulation is the
+    /// implicit solver's only.
+    fn visit<B, F, U>(self, basis: B, updater: U) -> Self::Output
+    where
+        B: InitialDomain<D, Mesh = RegularGrid<D>, Domain: Flat + DomainBounds<D>>,
+        F: Formulation,
+        U: DomainUpdater<D, B::Domain>,
+    {
+        self.with_basis(basis, updater)
     }
 }
 

@@ -295,15 +295,26 @@ pub trait VariantVisitor<const D: usize> {
         U: DomainUpdater<D, B::Domain>;
 }
 
-/// Calls `visitor` with the types of `variant`, or says why the
-/// combination is not available.
+/// Calls `visitor` with the types of `variant` for the implicit solver on
+/// a grid, or says why the combination is not available.
 pub fn dispatch<const D: usize, V: VariantVisitor<D>>(
     variant: &Variant,
     visitor: V,
 ) -> Result<V::Output, String> {
-    variant
-        .check(rules::Context::ImplicitGrid)
-        .map_err(|refusal| refusal.message)?;
+    dispatch_in(variant, rules::Context::ImplicitGrid, visitor)
+}
+
+/// [`dispatch`] for the solver of `context`: the variant is checked
+/// against the rules of that context first. The explicit runner visits
+/// through here too, so a basis registered once ([`register_bases!`])
+/// reaches both runners; it ignores the formulation type (the rules keep
+/// the explicit scene at the default one).
+pub fn dispatch_in<const D: usize, V: VariantVisitor<D>>(
+    variant: &Variant,
+    context: rules::Context<'_>,
+    visitor: V,
+) -> Result<V::Output, String> {
+    variant.check(context).map_err(|refusal| refusal.message)?;
     dispatch_basis(variant, visitor)
 }
 
