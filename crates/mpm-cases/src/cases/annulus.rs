@@ -56,8 +56,12 @@ use std::path::PathBuf;
 use mpm_solver::{SolverError, StepReport};
 use nalgebra::Vector2;
 
+use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    BodySpec, BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, RegionSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 pub use crate::manufactured::Torsion;
@@ -208,6 +212,52 @@ pub fn scene_text(p: &AnnulusParams, variant: &Variant) -> Result<String, Solver
         alpha = p.alpha,
         solver = super::solver_section(variant, p.load_steps, p.tolerance),
     ))
+}
+
+/// The annulus as a typed scene: the scene of [`scene_text`].
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] for a non-positive `h` or a variant other
+/// than standard MPM.
+pub fn scene(p: &AnnulusParams, variant: &Variant) -> Result<Scene, SolverError> {
+    variant
+        .require_standard_mpm("triangles")
+        .map_err(SolverError::InvalidInput)?;
+    let mesh = match &p.mesh {
+        Some(path) => MeshSpec::gmsh(path.display().to_string(), 2),
+        None => {
+            if !(p.h > 0.0 && p.h.is_finite()) {
+                return Err(SolverError::InvalidInput(format!(
+                    "h = {} must be positive",
+                    p.h
+                )));
+            }
+            let radial = ((p.outer_radius - p.inner_radius) / p.h).ceil().max(2.0) as usize;
+            let ring = (2.0 * std::f64::consts::PI * p.outer_radius / p.h)
+                .round()
+                .max(8.0) as usize;
+            MeshSpec::annulus(p.inner_radius, p.outer_radius, radial, ring).with_jitter(p.jitter, 1)
+        }
+    };
+    let material = MaterialSpec::new(
+        "annulus",
+        MaterialModel::Hencky,
+        p.youngs_modulus,
+        p.poisson_ratio,
+        0.0,
+    );
+    let body = BodySpec::new("annulus", "annulus", RegionSpec::group("domain"))
+        .with_points_per_cell(p.points_per_element);
+    let torsion = [
+        ("inner_radius", p.inner_radius),
+        ("outer_radius", p.outer_radius),
+        ("alpha", p.alpha),
+    ];
+    Ok(Scene::new(mesh, vec![material], vec![body])
+        .with_boundary(BoundarySpec::on("inner", BoundaryKind::Fixed))
+        .with_boundary(BoundarySpec::on("outer", BoundaryKind::Fixed))
+        .with_load(LoadSpec::manufactured("annulus_torsion", torsion))
+        .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)))
 }
 
 /// The annulus's scene, built.

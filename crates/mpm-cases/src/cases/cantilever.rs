@@ -11,8 +11,13 @@
 
 use mpm_solver::{SolverError, StepReport};
 
+use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    Axes, BodySpec, BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, NodeSetSpec,
+    RegionSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -171,6 +176,77 @@ pub fn scene_text(p: &CantileverParams, variant: &Variant) -> Result<String, Sol
         f = -p.load,
         solver = super::solver_section(variant, p.load_steps, p.tolerance),
     ))
+}
+
+/// The cantilever as a typed scene: the scene of [`scene_text`].
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] unless `h` divides half the depth and the
+/// length and `points_per_cell` is even.
+pub fn scene(p: &CantileverParams, variant: &Variant) -> Result<Scene, SolverError> {
+    let half = p.depth / 2.0;
+    let k = (half / p.h).round();
+    if k < 1.0
+        || (k * p.h - half).abs() > 1e-9
+        || !p.points_per_cell.is_multiple_of(2)
+        || (p.length / p.h).fract().abs() > 1e-9
+    {
+        return Err(SolverError::InvalidInput(format!(
+            "h = {} must divide half the depth ({half}) and the length, and points_per_cell = {} must be even",
+            p.h, p.points_per_cell
+        )));
+    }
+    // Room below for a tip deflection of about the beam length.
+    let below = (p.length / p.h).ceil() * p.h;
+    let cells = [
+        ((p.length + 1.0) / p.h).ceil() as usize,
+        ((below + p.depth + 0.5) / p.h).ceil() as usize,
+    ];
+    let (tol, step) = (1e-9 * p.h, p.h / p.points_per_cell as f64);
+    let (y_lo, y_hi) = (-below - 2.0 * p.h, p.depth + 2.0 * p.h + 0.5);
+    let material = MaterialSpec::new(
+        "beam",
+        MaterialModel::Hencky,
+        p.youngs_modulus,
+        p.poisson_ratio,
+        0.0,
+    );
+    let body = BodySpec::block(
+        "beam",
+        "beam",
+        [0.0, 0.0],
+        [p.length, p.depth],
+        p.points_per_cell,
+    )
+    .with_lattice_origin([0.0, 0.0]);
+    let end = RegionSpec::box_between([p.length - step, half - step], [p.length, half + step]);
+    Ok(Scene::new(
+        MeshSpec::grid(
+            [0.0, -below],
+            [cells[0] as f64 * p.h, cells[1] as f64 * p.h],
+            cells,
+        ),
+        vec![material],
+        vec![body],
+    )
+    .with_node_set(NodeSetSpec::inside(
+        "root",
+        RegionSpec::box_between([-tol, y_lo], [tol, y_hi]),
+    ))
+    .with_node_set(NodeSetSpec::inside(
+        "neutral_axis_at_root",
+        RegionSpec::box_between([-tol, half - tol], [tol, half + tol]),
+    ))
+    .with_boundary(
+        BoundarySpec::on("root", BoundaryKind::Displacement)
+            .with_displacement(Axes::default().with_x(0.0)),
+    )
+    .with_boundary(BoundarySpec::on(
+        "neutral_axis_at_root",
+        BoundaryKind::Fixed,
+    ))
+    .with_load(LoadSpec::point_in(end, [0.0, -p.load]))
+    .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)))
 }
 
 /// The cantilever's scene, built, and the indices of its two loaded

@@ -16,8 +16,12 @@
 
 use mpm_solver::{SolverError, StepReport};
 
+use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    BodySpec, BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -142,6 +146,40 @@ pub fn scene_text(p: &CollapseParams, variant: &Variant) -> Result<String, Solve
         g = -p.body_force,
         solver = super::solver_section(variant, p.load_steps, p.tolerance),
     ))
+}
+
+/// The collapse as a typed scene: the scene of [`scene_text`].
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] when `h` does not divide the widths and
+/// the height.
+pub fn scene(p: &CollapseParams, variant: &Variant) -> Result<Scene, SolverError> {
+    let nx = super::cells_along(p.h, p.grid_width, "the grid width")?;
+    let ny = super::cells_along(p.h, p.height, "the height")?;
+    super::cells_along(p.h, p.width, "the block width")?;
+    let material = MaterialSpec::new(
+        "block",
+        MaterialModel::VonMises,
+        p.youngs_modulus,
+        p.poisson_ratio,
+        1.0,
+    )
+    .with_yield_stress(p.yield_stress);
+    Ok(Scene::new(
+        MeshSpec::grid([0.0, 0.0], [p.grid_width, p.height + p.h], [nx, ny + 1]),
+        vec![material],
+        vec![BodySpec::block(
+            "block",
+            "block",
+            [0.0, 0.0],
+            [p.width, p.height],
+            p.points_per_cell,
+        )],
+    )
+    .with_boundary(BoundarySpec::on("x_min", BoundaryKind::Roller))
+    .with_boundary(BoundarySpec::on("y_min", BoundaryKind::Roller))
+    .with_load(LoadSpec::gravity([0.0, -p.body_force]))
+    .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)))
 }
 
 /// The collapse's scene, built.

@@ -12,7 +12,10 @@ use mpm_solver::SolverError;
 
 use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    BodySpec, BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -147,6 +150,41 @@ pub fn scene_text(p: &ColumnParams, variant: &Variant) -> Result<String, SolverE
         g = -p.gravity,
         solver = super::solver_section(variant, p.load_steps, p.tolerance),
     ))
+}
+
+/// The column as a typed scene: the scene of [`scene_text`].
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] when `h` does not divide the height.
+pub fn scene(p: &ColumnParams, variant: &Variant) -> Result<Scene, SolverError> {
+    let cells_y = super::cells_along(p.h, p.height, "the column height")?;
+    let material = MaterialSpec::new(
+        "column",
+        p.material,
+        p.youngs_modulus,
+        p.poisson_ratio,
+        p.density,
+    );
+    let material = match p.yield_stress {
+        Some(y) => material.with_yield_stress(y).with_hardening(p.hardening),
+        None => material,
+    };
+    Ok(Scene::new(
+        MeshSpec::grid([0.0, 0.0], [p.h, p.height], [1, cells_y]),
+        vec![material],
+        vec![BodySpec::block(
+            "column",
+            "column",
+            [0.0, 0.0],
+            [p.h, p.height],
+            p.points_per_cell,
+        )],
+    )
+    .with_boundary(BoundarySpec::on("x_min", BoundaryKind::Roller))
+    .with_boundary(BoundarySpec::on("x_max", BoundaryKind::Roller))
+    .with_boundary(BoundarySpec::on("y_min", BoundaryKind::Roller))
+    .with_load(LoadSpec::gravity([0.0, -p.gravity]))
+    .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)))
 }
 
 /// The column's scene, built.

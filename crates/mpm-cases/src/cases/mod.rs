@@ -18,6 +18,8 @@ pub mod annulus;
 pub mod cantilever;
 pub mod collapse;
 pub mod column;
+#[cfg(test)]
+mod scene_tests;
 pub mod shear;
 pub mod stretch;
 
@@ -168,6 +170,26 @@ pub(crate) fn simplices_of<const D: usize>(
             Err(mpm_solver::SolverError::InvalidInput(what.into()))
         }
     }
+}
+
+/// The number of cells of size `h` along `length` (`what`, e.g. "the
+/// column height"), which `h` must divide.
+///
+/// # Errors
+/// [`mpm_solver::SolverError::InvalidInput`] when it does not (to 1e-9
+/// relative), or gives no cell.
+pub(crate) fn cells_along(
+    h: f64,
+    length: f64,
+    what: &str,
+) -> Result<usize, mpm_solver::SolverError> {
+    let n = (length / h).round();
+    if n.is_nan() || n < 1.0 || (n * h - length).abs() > 1e-9 * length {
+        return Err(mpm_solver::SolverError::InvalidInput(format!(
+            "h = {h} must divide {what} {length}"
+        )));
+    }
+    Ok(n as usize)
 }
 
 /// The `[solver]` section of a case's scene: the variant, the number of

@@ -43,8 +43,12 @@ use mpm_constitutive::{
 use mpm_solver::{Flat, SolverError, StepReport};
 use nalgebra::{Matrix2, Matrix3};
 
+use crate::material::MaterialModel;
 use crate::run::{Checkpoint, RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    BodySpec, BoundaryKind, BoundarySpec, MaterialSpec, MeshSpec, NodeSetSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -233,6 +237,68 @@ pub fn scene_text(p: &ShearParams, variant: &Variant) -> Result<String, SolverEr
         g = p.shear,
         solver = super::solver_section(variant, p.load_steps, p.tolerance),
         pred = p.predictor,
+    ))
+}
+
+/// The shear as a typed scene: the scene of [`scene_text`].
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] unless `h` divides 1 and `grid_offset`
+/// lies in [0, 1).
+pub fn scene(p: &ShearParams, variant: &Variant) -> Result<Scene, SolverError> {
+    let cells = (1.0 / p.h).round();
+    if cells < 1.0 || (cells * p.h - 1.0).abs() > 1e-9 {
+        return Err(SolverError::InvalidInput(format!(
+            "h = {} must divide 1",
+            p.h
+        )));
+    }
+    if !(0.0..1.0).contains(&p.grid_offset) {
+        return Err(SolverError::InvalidInput(format!(
+            "grid_offset = {} must lie in [0, 1)",
+            p.grid_offset
+        )));
+    }
+    let nx = ((1.0 + p.shear.abs()) / p.h).ceil() as usize + 2;
+    let ny = cells as usize;
+    let left = if p.shear < 0.0 {
+        p.shear.abs() + p.h
+    } else {
+        0.0
+    };
+    let model = match p.yield_stress {
+        Some(_) => MaterialModel::VonMises,
+        None => MaterialModel::Hencky,
+    };
+    let material = MaterialSpec::new("square", model, p.youngs_modulus, p.poisson_ratio, 0.0);
+    let material = match p.yield_stress {
+        Some(y) => material.with_yield_stress(y),
+        None => material,
+    };
+    let body = BodySpec::block(
+        "square",
+        "square",
+        [0.0, 0.0],
+        [1.0, 1.0],
+        p.points_per_cell,
+    )
+    .with_lattice_origin([0.0, 0.0]);
+    Ok(Scene::new(
+        MeshSpec::grid(
+            [-p.grid_offset * p.h - left, 0.0],
+            [nx as f64 * p.h, ny as f64 * p.h],
+            [nx, ny],
+        ),
+        vec![material],
+        vec![body],
+    )
+    .with_node_set(NodeSetSpec::around("shell", "square"))
+    .with_boundary(
+        BoundarySpec::on("shell", BoundaryKind::Displacement)
+            .with_gradient(vec![vec![0.0, p.shear], vec![0.0, 0.0]]),
+    )
+    .with_solver(
+        SolverSpec::implicit(variant, p.load_steps, p.tolerance).with_predictor(p.predictor),
     ))
 }
 

@@ -29,8 +29,13 @@ use std::path::PathBuf;
 use mpm_solver::{SolverError, StepReport};
 use nalgebra::Matrix3;
 
+use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    Axes, BodySpec, BoundaryKind, BoundarySpec, MaterialSpec, MeshSpec, MotionSpec, Placement,
+    RegionSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -203,6 +208,57 @@ pub fn scene_text(p: &StretchParams, variant: &Variant) -> Result<String, Solver
         solver = super::solver_section(variant, p.load_steps, p.tolerance),
         pred = p.predictor,
     ))
+}
+
+/// The stretch as a typed scene: the scene of [`scene_text`].
+///
+/// # Errors
+/// [`SolverError::InvalidInput`] for a variant other than standard MPM or
+/// F-patch.
+pub fn scene(p: &StretchParams, variant: &Variant) -> Result<Scene, SolverError> {
+    // The built-in mesh splits ten-node parents (patches); a Gmsh mesh has
+    // patches when it is quadratic, which the scene checks.
+    variant
+        .require_simplex("tetrahedra", true)
+        .map_err(SolverError::InvalidInput)?;
+    let a = p.size;
+    let mesh = match &p.mesh {
+        Some(path) => MeshSpec::gmsh(path.display().to_string(), 3),
+        None => MeshSpec::simplex_box([0.0; 3], [a; 3], [p.cells, 2, p.cells]).with_patches(true),
+    };
+    let components: &[&str] = if p.clamped_top {
+        &["x", "y", "z"]
+    } else {
+        &["y"]
+    };
+    let motion = MotionSpec::stretch("y", "y1")
+        .with_stretch(0.0, a, p.stretch)
+        .with_components(components);
+    let material = MaterialSpec::new(
+        "cube",
+        MaterialModel::VonMises,
+        p.youngs_modulus,
+        p.poisson_ratio,
+        0.0,
+    )
+    .with_yield_stress(p.yield_stress)
+    .with_hardening(p.hardening);
+    let body = BodySpec::new("cube", "cube", RegionSpec::box_between([0.0; 3], [a; 3]))
+        .with_placement(Placement::Keast11);
+    let roller = |set: &str, axes: Axes| {
+        BoundarySpec::on(set, BoundaryKind::Displacement).with_displacement(axes)
+    };
+    let free = Axes::default();
+    Ok(
+        Scene::new(mesh.with_motion(motion), vec![material], vec![body])
+            .with_boundary(roller("x0", free.with_x(0.0)))
+            .with_boundary(roller("y0", free.with_y(0.0)))
+            .with_boundary(roller("z0", free.with_z(0.0)))
+            .with_solver(
+                SolverSpec::implicit(variant, p.load_steps, p.tolerance)
+                    .with_predictor(p.predictor),
+            ),
+    )
 }
 
 /// The stretch's scene, built.
