@@ -161,60 +161,12 @@ pub struct AnnulusResult {
     pub element_size: f64,
 }
 
-/// The annulus as a scene (the text of `scenes/coombs2020_annulus.toml`
+/// The annulus as a typed scene (the scene of `scenes/coombs2020_annulus.toml`
 /// with the parameters filled in): the generated annulus mesh of element
 /// size about `h` (round((R_o − R_i)/h) layers, at least 2, and
 /// round(2π R_o/h) nodes per ring, at least 8), or the Gmsh file `mesh`
 /// (linear triangles with physical groups `inner`, `outer` and `domain`);
 /// both rims fixed; the manufactured body force of eq. (44).
-///
-/// # Errors
-/// [`SolverError::InvalidInput`] for a non-positive `h` or a variant other
-/// than standard MPM.
-pub fn scene_text(p: &AnnulusParams, variant: &Variant) -> Result<String, SolverError> {
-    variant
-        .require_standard_mpm("triangles")
-        .map_err(SolverError::InvalidInput)?;
-    let mesh = match &p.mesh {
-        Some(path) => format!(
-            "kind = \"gmsh\"\nfile = {}\ndimension = 2\n",
-            toml::Value::String(path.display().to_string())
-        ),
-        None => {
-            if !(p.h > 0.0 && p.h.is_finite()) {
-                return Err(SolverError::InvalidInput(format!(
-                    "h = {} must be positive",
-                    p.h
-                )));
-            }
-            let radial = ((p.outer_radius - p.inner_radius) / p.h).ceil().max(2.0) as usize;
-            let ring = (2.0 * std::f64::consts::PI * p.outer_radius / p.h)
-                .round()
-                .max(8.0) as usize;
-            format!(
-                "kind = \"annulus\"\ninner_radius = {:?}\nouter_radius = {:?}\nlayers = {radial}\nring_nodes = {ring}\njitter = {:?}\nseed = 1\n",
-                p.inner_radius, p.outer_radius, p.jitter
-            )
-        }
-    };
-    Ok(format!(
-        "[mesh]\n{mesh}\n\
-         [[material]]\nname = \"annulus\"\nmodel = \"hencky\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\n\n\
-         [[body]]\nname = \"annulus\"\nmaterial = \"annulus\"\nregion = {{ group = \"domain\" }}\npoints_per_cell = {ppe}\n\n\
-         [[boundary]]\nset = \"inner\"\nkind = \"fixed\"\n\n\
-         [[boundary]]\nset = \"outer\"\nkind = \"fixed\"\n\n\
-         [[load]]\nkind = \"manufactured\"\nfield = \"annulus_torsion\"\nparameters = {{ inner_radius = {ri:?}, outer_radius = {ro:?}, alpha = {alpha:?} }}\n\n{solver}",
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        ppe = p.points_per_element,
-        ri = p.inner_radius,
-        ro = p.outer_radius,
-        alpha = p.alpha,
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
-    ))
-}
-
-/// The annulus as a typed scene: the scene of [`scene_text`].
 ///
 /// # Errors
 /// [`SolverError::InvalidInput`] for a non-positive `h` or a variant other
@@ -263,13 +215,13 @@ pub fn scene(p: &AnnulusParams, variant: &Variant) -> Result<Scene, SolverError>
 /// The annulus's scene, built.
 ///
 /// # Errors
-/// As [`scene_text`], and the scene's own checks.
+/// As [`scene`], and the scene's own checks.
 pub fn problem(p: &AnnulusParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(&scene_text(p, variant)?, "annulus", 0)
+    super::build_scene(&scene(p, variant)?, "annulus", 0)
 }
 
 /// Runs the annulus with `variant` (standard MPM on the triangles; UL or
-/// PC): its scene ([`scene_text`]), built and run, measured against the
+/// PC): its scene ([`scene`]), built and run, measured against the
 /// exact displacement.
 ///
 /// # Errors

@@ -113,7 +113,7 @@ pub struct CantileverResult {
     pub material_points: usize,
 }
 
-/// The cantilever as a scene (the text of
+/// The cantilever as a typed scene (the scene of
 /// `scenes/coombs2020_cantilever.toml` with the parameters and variant
 /// filled in): a grid with room below for a tip deflection of about the
 /// beam length and the padding the basis needs; the root a wall (every
@@ -123,62 +123,6 @@ pub struct CantileverResult {
 /// column that straddle the neutral axis. The points' lattice is anchored
 /// at the beam's corner, not at the grid's origin 10 m below, so that
 /// their coordinates are (i + ½)·h/n exactly as the beam's own lattice.
-///
-/// # Errors
-/// [`SolverError::InvalidInput`] unless `h` divides half the depth and the
-/// length and `points_per_cell` is even.
-pub fn scene_text(p: &CantileverParams, variant: &Variant) -> Result<String, SolverError> {
-    let half = p.depth / 2.0;
-    let k = (half / p.h).round();
-    if k < 1.0
-        || (k * p.h - half).abs() > 1e-9
-        || !p.points_per_cell.is_multiple_of(2)
-        || (p.length / p.h).fract().abs() > 1e-9
-    {
-        return Err(SolverError::InvalidInput(format!(
-            "h = {} must divide half the depth ({half}) and the length, and points_per_cell = {} must be even",
-            p.h, p.points_per_cell
-        )));
-    }
-    // Room below for a tip deflection of about the beam length.
-    let below = (p.length / p.h).ceil() * p.h;
-    let cells = [
-        ((p.length + 1.0) / p.h).ceil() as usize,
-        ((below + p.depth + 0.5) / p.h).ceil() as usize,
-    ];
-    let (tol, step) = (1e-9 * p.h, p.h / p.points_per_cell as f64);
-    let (y_lo, y_hi) = (-below - 2.0 * p.h, p.depth + 2.0 * p.h + 0.5);
-    Ok(format!(
-        "[mesh]\norigin = [0.0, {oy:?}]\nsize = [{sx:?}, {sy:?}]\ncells = [{cx}, {cy}]\n\n\
-         [[material]]\nname = \"beam\"\nmodel = \"hencky\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\n\n\
-         [[body]]\nname = \"beam\"\nmaterial = \"beam\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [{l:?}, {d:?}] }} }}\npoints_per_cell = {ppc}\nlattice_origin = [0.0, 0.0]\n\n\
-         [[node_set]]\nname = \"root\"\nregion = {{ box = {{ lower = [{mt:?}, {y_lo:?}], upper = [{tol:?}, {y_hi:?}] }} }}\n\n\
-         [[node_set]]\nname = \"neutral_axis_at_root\"\nregion = {{ box = {{ lower = [{mt:?}, {na_lo:?}], upper = [{tol:?}, {na_hi:?}] }} }}\n\n\
-         [[boundary]]\nset = \"root\"\nkind = \"displacement\"\ndisplacement = {{ x = 0.0 }}\n\n\
-         [[boundary]]\nset = \"neutral_axis_at_root\"\nkind = \"fixed\"\n\n\
-         [[load]]\nkind = \"point\"\nregion = {{ box = {{ lower = [{lx:?}, {ly_lo:?}], upper = [{l:?}, {ly_hi:?}] }} }}\nforce = [0.0, {f:?}]\n\n{solver}",
-        oy = -below,
-        sx = cells[0] as f64 * p.h,
-        sy = cells[1] as f64 * p.h,
-        cx = cells[0],
-        cy = cells[1],
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        l = p.length,
-        d = p.depth,
-        ppc = p.points_per_cell,
-        mt = -tol,
-        na_lo = half - tol,
-        na_hi = half + tol,
-        lx = p.length - step,
-        ly_lo = half - step,
-        ly_hi = half + step,
-        f = -p.load,
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
-    ))
-}
-
-/// The cantilever as a typed scene: the scene of [`scene_text`].
 ///
 /// # Errors
 /// [`SolverError::InvalidInput`] unless `h` divides half the depth and the
@@ -253,17 +197,13 @@ pub fn scene(p: &CantileverParams, variant: &Variant) -> Result<Scene, SolverErr
 /// points.
 ///
 /// # Errors
-/// As [`scene_text`], the scene's own checks, and an end that does not
+/// As [`scene`], the scene's own checks, and an end that does not
 /// hold exactly two points.
 pub fn problem(
     p: &CantileverParams,
     variant: &Variant,
 ) -> Result<(Problem<2>, [usize; 2]), SolverError> {
-    let problem = super::build_scene(
-        &scene_text(p, variant)?,
-        "cantilever",
-        variant.basis.padding(),
-    )?;
+    let problem = super::build_scene(&scene(p, variant)?, "cantilever", variant.basis.padding())?;
     match problem.point_forces.as_slice() {
         [(a, _), (b, _)] => {
             let loaded = [*a, *b];
@@ -307,7 +247,7 @@ where
     })
 }
 
-/// Runs the cantilever with `variant`: its scene ([`scene_text`]), built
+/// Runs the cantilever with `variant`: its scene ([`scene`]), built
 /// and run.
 ///
 /// # Errors

@@ -101,54 +101,11 @@ pub struct CollapseResult {
     pub material_points: usize,
 }
 
-/// The collapse as a scene (the text of `scenes/coombs2020_collapse.toml`
+/// The collapse as a typed scene (the scene of `scenes/coombs2020_collapse.toml`
 /// with the parameters and variant filled in): a grid of `grid_width` by
 /// `height + h` with the padding the basis needs, rollers on the base and
 /// the symmetry line (their padding nodes held alike), the body force as
 /// the weight of a unit density.
-///
-/// # Errors
-/// [`SolverError::InvalidInput`] when `h` does not divide the widths and
-/// the height.
-pub fn scene_text(p: &CollapseParams, variant: &Variant) -> Result<String, SolverError> {
-    let cells = |len: f64, what: &str| {
-        let n = (len / p.h).round();
-        if n < 1.0 || (n * p.h - len).abs() > 1e-9 * len {
-            Err(SolverError::InvalidInput(format!(
-                "h = {} must divide the {what} {len}",
-                p.h
-            )))
-        } else {
-            Ok(n as usize)
-        }
-    };
-    let (nx, ny) = (
-        cells(p.grid_width, "grid width")?,
-        cells(p.height, "height")?,
-    );
-    cells(p.width, "block width")?;
-    Ok(format!(
-        "[mesh]\norigin = [0.0, 0.0]\nsize = [{gw:?}, {gh:?}]\ncells = [{nx}, {cy}]\n\n\
-         [[material]]\nname = \"block\"\nmodel = \"von_mises\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 1.0\nyield_stress = {ys:?}\n\n\
-         [[body]]\nname = \"block\"\nmaterial = \"block\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [{w:?}, {hh:?}] }} }}\npoints_per_cell = {ppc}\n\n\
-         [[boundary]]\nset = \"x_min\"\nkind = \"roller\"\n\n\
-         [[boundary]]\nset = \"y_min\"\nkind = \"roller\"\n\n\
-         [[load]]\nkind = \"gravity\"\nacceleration = [0.0, {g:?}]\n\n{solver}",
-        gw = p.grid_width,
-        gh = p.height + p.h,
-        cy = ny + 1,
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        ys = p.yield_stress,
-        w = p.width,
-        hh = p.height,
-        ppc = p.points_per_cell,
-        g = -p.body_force,
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
-    ))
-}
-
-/// The collapse as a typed scene: the scene of [`scene_text`].
 ///
 /// # Errors
 /// [`SolverError::InvalidInput`] when `h` does not divide the widths and
@@ -185,13 +142,9 @@ pub fn scene(p: &CollapseParams, variant: &Variant) -> Result<Scene, SolverError
 /// The collapse's scene, built.
 ///
 /// # Errors
-/// As [`scene_text`], and the scene's own checks.
+/// As [`scene`], and the scene's own checks.
 pub fn problem(p: &CollapseParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(
-        &scene_text(p, variant)?,
-        "collapse",
-        variant.basis.padding(),
-    )
+    super::build_scene(&scene(p, variant)?, "collapse", variant.basis.padding())
 }
 
 /// Runs the built collapse and measures the body's extent.
@@ -233,7 +186,7 @@ where
     })
 }
 
-/// Runs the collapse with `variant`: its scene ([`scene_text`]), built and
+/// Runs the collapse with `variant`: its scene ([`scene`]), built and
 /// run.
 ///
 /// # Errors

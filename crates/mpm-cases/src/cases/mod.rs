@@ -192,36 +192,16 @@ pub(crate) fn cells_along(
     Ok(n as usize)
 }
 
-/// The `[solver]` section of a case's scene: the variant, the number of
-/// equal steps and the Newton tolerance.
-pub(crate) fn solver_section(
-    variant: &crate::variant::Variant,
-    steps: usize,
-    tolerance: f64,
-) -> String {
-    format!(
-        "[solver]\nbasis = \"{}\"\nformulation = \"{}\"\nlocking = \"{}\"\ndomain_update = \"{}\"\ngimp_volume = \"{}\"\nsteps = {steps}\ntolerance = {tolerance:?}\n",
-        variant.basis,
-        variant.formulation,
-        variant.locking,
-        variant.domain_update,
-        variant.gimp_volume
-    )
-}
-
-/// Builds the scene a case wrote as `text` (named `case` in errors): a
-/// case's parameters that make no valid scene are refused with the
-/// scene's message.
+/// Builds a case's typed `scene` (named `case` in errors): a case's
+/// parameters that make no valid scene are refused with the scene's
+/// message, which names the case's scene (it has no file, so no line and
+/// column: [`mpm_scene::source::SceneSource::typed`]).
 pub(crate) fn build_scene<const D: usize>(
-    text: &str,
+    scene: &crate::scene::Scene,
     case: &str,
     padding: usize,
 ) -> Result<crate::scene::Problem<D>, mpm_solver::SolverError> {
-    let invalid = |e: mpm_scene::SceneError| {
-        mpm_solver::SolverError::InvalidInput(format!("case {case}: {e}"))
-    };
-    let (scene, src) =
-        crate::scene::parse(text, &format!("the {case} case's scene"), &[]).map_err(invalid)?;
-    crate::scene::Problem::<D>::build_in(&scene, &src, padding, std::path::Path::new(""))
-        .map_err(invalid)
+    let source = mpm_scene::source::SceneSource::typed(&format!("the {case} case's scene"));
+    crate::scene::Problem::<D>::build_in(scene, &source, padding, std::path::Path::new(""))
+        .map_err(|e| mpm_solver::SolverError::InvalidInput(format!("case {case}: {e}")))
 }

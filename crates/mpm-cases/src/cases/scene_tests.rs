@@ -1,7 +1,7 @@
-//! The cases' typed scenes are the scenes of their old text: for every
-//! variant and several parameter sets, `scene(p, v)` equals the parse of
-//! `scene_text(p, v)`, and both refuse the same parameters with the same
-//! words.
+//! Every case is expressible as a scene file: its typed scene, written
+//! with `toml::to_string` and parsed again, is the same scene, for every
+//! variant the case accepts. And a case's scene has no file, so its errors
+//! name the case's scene without a line and column.
 
 use mpm_solver::SolverError;
 
@@ -34,216 +34,90 @@ fn every_variant() -> Vec<Variant> {
     all
 }
 
-/// How many variants both accepted (with equal scenes) and both refused.
-#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
-struct Count {
-    matched: usize,
-    refused: usize,
-}
-
-/// Compares `typed` with the parse of `text` for `p` and every variant.
-fn compare<P>(
+/// Writes and reads back the scene of `p` with every variant `scene`
+/// accepts; returns how many it accepted.
+fn round_trips<P>(
     case: &str,
     p: &P,
-    text: fn(&P, &Variant) -> Result<String, SolverError>,
-    typed: fn(&P, &Variant) -> Result<Scene, SolverError>,
-) -> Count {
-    let mut count = Count::default();
+    scene: fn(&P, &Variant) -> Result<Scene, SolverError>,
+) -> usize {
+    let mut accepted = 0;
     for v in every_variant() {
-        match (text(p, &v), typed(p, &v)) {
-            (Ok(text), Ok(scene)) => {
-                let (parsed, _) = crate::scene::parse(&text, case, &[])
-                    .unwrap_or_else(|e| panic!("{case} {v:?}: {e}\n{text}"));
-                assert_eq!(scene, parsed, "{case} {v:?}\n{text}");
-                count.matched += 1;
-            }
-            (Err(a), Err(b)) => {
-                assert_eq!(a.to_string(), b.to_string(), "{case} {v:?}");
-                count.refused += 1;
-            }
-            (a, b) => panic!(
-                "{case} {v:?}: the text gives {:?}, the typed scene {:?}",
-                a.map(|_| "a scene"),
-                b.map(|_| "a scene")
-            ),
-        }
+        let Ok(typed) = scene(p, &v) else { continue };
+        let text = toml::to_string(&typed).unwrap_or_else(|e| panic!("{case} {v:?}: {e}"));
+        let (parsed, _) = crate::scene::parse(&text, case, &[])
+            .unwrap_or_else(|e| panic!("{case} {v:?}: {e}\n{text}"));
+        assert_eq!(parsed, typed, "{case} {v:?}\n{text}");
+        accepted += 1;
     }
-    count
+    accepted
 }
 
 #[test]
-fn every_case_and_variant_gives_the_scene_of_its_text() {
-    let mut total = Count::default();
-    let mut add = |case: &str, params: &str, c: Count| {
-        eprintln!(
-            "{case} ({params}): {} variants equal, {} refused by both",
-            c.matched, c.refused
-        );
-        total.matched += c.matched;
-        total.refused += c.refused;
-    };
-    add(
-        "column",
-        "defaults",
-        compare(
-            "column",
-            &column::ColumnParams::default(),
-            column::scene_text,
-            column::scene,
-        ),
-    );
-    add(
-        "shear",
-        "defaults",
-        compare(
-            "shear",
-            &shear::ShearParams::default(),
-            shear::scene_text,
-            shear::scene,
-        ),
-    );
-    add(
-        "cantilever",
-        "defaults",
-        compare(
+fn every_case_round_trips_through_a_scene_file() {
+    let accepted = [
+        round_trips("column", &column::ColumnParams::default(), column::scene),
+        round_trips("shear", &shear::ShearParams::default(), shear::scene),
+        round_trips(
             "cantilever",
             &cantilever::CantileverParams::default(),
-            cantilever::scene_text,
             cantilever::scene,
         ),
-    );
-    add(
-        "annulus",
-        "defaults",
-        compare(
-            "annulus",
-            &annulus::AnnulusParams::default(),
-            annulus::scene_text,
-            annulus::scene,
-        ),
-    );
-    add(
-        "collapse",
-        "defaults",
-        compare(
+        round_trips(
             "collapse",
             &collapse::CollapseParams::default(),
-            collapse::scene_text,
             collapse::scene,
         ),
-    );
-    add(
-        "stretch",
-        "defaults",
-        compare(
+        round_trips(
+            "annulus",
+            &annulus::AnnulusParams::default(),
+            annulus::scene,
+        ),
+        round_trips(
             "stretch",
             &stretch::StretchParams::default(),
-            stretch::scene_text,
             stretch::scene,
         ),
-    );
-    eprintln!(
-        "defaults, all cases: {} (case, variant) pairs equal, {} refused by both",
-        total.matched, total.refused
-    );
-    // Every variant of the grid cases; the simplex cases' own.
-    assert_eq!(total.matched, 4 * 720 + 2 + 4, "{total:?}");
-}
-
-/// The keys that only some parameters write: plasticity, a negative
-/// shear, a clamped top, Gmsh files, jitter; and parameters refused.
-#[test]
-fn other_parameters_give_the_scene_of_their_text() {
-    let column = column::ColumnParams {
+    ];
+    // The grid cases write every variant (the build refuses those that do
+    // not run); the annulus standard MPM (UL, PC), the stretch also F-patch.
+    assert_eq!(accepted, [720, 720, 720, 720, 2, 4]);
+    // The keys only some parameters write.
+    let plastic = column::ColumnParams {
         yield_stress: Some(3e4),
         hardening: 1e5,
         material: crate::material::MaterialModel::VonMises,
         ..Default::default()
     };
-    let elastic_hardening = column::ColumnParams {
-        hardening: 1e5,
+    assert_eq!(round_trips("column", &plastic, column::scene), 720);
+    let gmsh = stretch::StretchParams {
+        mesh: Some("meshes/cube \"quoted\".msh".into()),
+        clamped_top: true,
         ..Default::default()
     };
-    let bad_column = column::ColumnParams {
-        h: 3.0,
+    assert_eq!(round_trips("stretch", &gmsh, stretch::scene), 4);
+    let jitter = annulus::AnnulusParams {
+        jitter: 0.1,
         ..Default::default()
     };
-    for p in [column, elastic_hardening, bad_column] {
-        compare("column", &p, column::scene_text, column::scene);
-    }
-    for p in [
-        shear::ShearParams {
-            yield_stress: Some(5e3),
-            shear: -2.0,
-            predictor: false,
-            ..Default::default()
-        },
-        shear::ShearParams {
-            h: 0.3,
-            ..Default::default()
-        },
-        shear::ShearParams {
-            grid_offset: 1.5,
-            ..Default::default()
-        },
-    ] {
-        compare("shear", &p, shear::scene_text, shear::scene);
-    }
-    for p in [
-        stretch::StretchParams {
-            clamped_top: true,
-            hardening: 10.0,
-            cells: 4,
-            ..Default::default()
-        },
-        stretch::StretchParams {
-            mesh: Some("meshes/cube \"quoted\".msh".into()),
-            ..Default::default()
-        },
-    ] {
-        compare("stretch", &p, stretch::scene_text, stretch::scene);
-    }
-    for p in [
-        annulus::AnnulusParams {
-            jitter: 0.1,
-            h: 0.0625,
-            ..Default::default()
-        },
-        annulus::AnnulusParams {
-            mesh: Some("meshes/annulus.msh".into()),
-            ..Default::default()
-        },
-        annulus::AnnulusParams {
-            h: -1.0,
-            ..Default::default()
-        },
-    ] {
-        compare("annulus", &p, annulus::scene_text, annulus::scene);
-    }
-    for p in [
-        collapse::CollapseParams {
-            h: 0.5,
-            points_per_cell: 2,
-            ..Default::default()
-        },
-        collapse::CollapseParams {
-            h: 3.0,
-            ..Default::default()
-        },
-    ] {
-        compare("collapse", &p, collapse::scene_text, collapse::scene);
-    }
-    for p in [
-        cantilever::CantileverParams {
-            h: 0.25,
-            points_per_cell: 2,
-            ..Default::default()
-        },
-        cantilever::CantileverParams {
-            points_per_cell: 3,
-            ..Default::default()
-        },
-    ] {
-        compare("cantilever", &p, cantilever::scene_text, cantilever::scene);
-    }
+    assert_eq!(round_trips("annulus", &jitter, annulus::scene), 2);
+}
+
+/// A case's parameters the scene refuses: the message names the case's
+/// scene, with no line and column of a file that does not exist.
+#[test]
+fn a_case_scene_error_names_the_case_not_a_line() {
+    let p = column::ColumnParams {
+        youngs_modulus: -5.0,
+        ..Default::default()
+    };
+    let e = column::problem(&p, &p.variant())
+        .map(|_| ())
+        .expect_err("a negative modulus is refused");
+    let message = e.to_string();
+    let rest = message
+        .strip_prefix("invalid input: case column: the column case's scene: ")
+        .unwrap_or_else(|| panic!("{message}"));
+    assert!(rest.contains("Young's modulus"), "{message}");
+    assert!(!rest.starts_with(|c: char| c.is_ascii_digit()), "{message}");
 }

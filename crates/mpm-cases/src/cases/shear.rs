@@ -187,60 +187,12 @@ pub fn elastic_closed_form(mu: f64, gamma: f64) -> Matrix3<f64> {
     Matrix3::new(s11, s12, 0.0, s12, -s11, 0.0, 0.0, 0.0, 0.0)
 }
 
-/// The shear as a scene (the text of `scenes/coombs2020_shear.toml` with
+/// The shear as a typed scene (the scene of `scenes/coombs2020_shear.toml` with
 /// the parameters and variant filled in): an h-spaced grid shifted left of
 /// the body by `grid_offset`·h, with room for the shear and the padding the
 /// basis needs; the unit square's points on a lattice anchored at its
 /// corner; $\Delta u = \Delta\gamma\,(Y_v, 0)$ on every node that
 /// supports a boundary point, found again every step (`around`).
-///
-/// # Errors
-/// [`SolverError::InvalidInput`] unless `h` divides 1 and `grid_offset`
-/// lies in [0, 1).
-pub fn scene_text(p: &ShearParams, variant: &Variant) -> Result<String, SolverError> {
-    let cells = (1.0 / p.h).round();
-    if cells < 1.0 || (cells * p.h - 1.0).abs() > 1e-9 {
-        return Err(SolverError::InvalidInput(format!(
-            "h = {} must divide 1",
-            p.h
-        )));
-    }
-    if !(0.0..1.0).contains(&p.grid_offset) {
-        return Err(SolverError::InvalidInput(format!(
-            "grid_offset = {} must lie in [0, 1)",
-            p.grid_offset
-        )));
-    }
-    let nx = ((1.0 + p.shear.abs()) / p.h).ceil() as usize + 2;
-    let ny = cells as usize;
-    let left = if p.shear < 0.0 {
-        p.shear.abs() + p.h
-    } else {
-        0.0
-    };
-    let plastic = match p.yield_stress {
-        Some(y) => format!("model = \"von_mises\"\nyield_stress = {y:?}\n"),
-        None => "model = \"hencky\"\n".to_owned(),
-    };
-    Ok(format!(
-        "[mesh]\norigin = [{ox:?}, 0.0]\nsize = [{sx:?}, {sy:?}]\ncells = [{nx}, {ny}]\n\n\
-         [[material]]\nname = \"square\"\n{plastic}youngs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\n\n\
-         [[body]]\nname = \"square\"\nmaterial = \"square\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [1.0, 1.0] }} }}\npoints_per_cell = {ppc}\nlattice_origin = [0.0, 0.0]\n\n\
-         [[node_set]]\nname = \"shell\"\naround = \"square\"\n\n\
-         [[boundary]]\nset = \"shell\"\nkind = \"displacement\"\ngradient = [[0.0, {g:?}], [0.0, 0.0]]\n\n{solver}predictor = {pred}\n",
-        ox = -p.grid_offset * p.h - left,
-        sx = nx as f64 * p.h,
-        sy = ny as f64 * p.h,
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        ppc = p.points_per_cell,
-        g = p.shear,
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
-        pred = p.predictor,
-    ))
-}
-
-/// The shear as a typed scene: the scene of [`scene_text`].
 ///
 /// # Errors
 /// [`SolverError::InvalidInput`] unless `h` divides 1 and `grid_offset`
@@ -305,12 +257,12 @@ pub fn scene(p: &ShearParams, variant: &Variant) -> Result<Scene, SolverError> {
 /// The shear's scene, built.
 ///
 /// # Errors
-/// As [`scene_text`], and the scene's own checks.
+/// As [`scene`], and the scene's own checks.
 pub fn problem(p: &ShearParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(&scene_text(p, variant)?, "shear", variant.basis.padding())
+    super::build_scene(&scene(p, variant)?, "shear", variant.basis.padding())
 }
 
-/// Runs the shear with `variant`: its scene ([`scene_text`]), built and
+/// Runs the shear with `variant`: its scene ([`scene`]), built and
 /// run, every point's stress measured against the single-point reference.
 ///
 /// # Errors

@@ -153,64 +153,12 @@ pub struct StretchResult {
     pub elements: usize,
 }
 
-/// The stretch as a scene (the text of `scenes/wang2021_stretch.toml`
+/// The stretch as a typed scene (the scene of `scenes/wang2021_stretch.toml`
 /// with the parameters filled in): the cube of `cells` × 2 × `cells`
 /// cells, each split into six ten-node tetrahedra and those into their
 /// eight linear children (or the Gmsh file `mesh`), Keast's 11 points per
 /// child, the faces x0, y0, z0 on rollers, the mesh stretching along y
 /// with the face y1 driven (also laterally with `clamped_top`).
-///
-/// # Errors
-/// [`SolverError::InvalidInput`] for a variant other than standard MPM or
-/// F-patch.
-pub fn scene_text(p: &StretchParams, variant: &Variant) -> Result<String, SolverError> {
-    // The built-in mesh splits ten-node parents (patches); a Gmsh mesh has
-    // patches when it is quadratic, which the scene checks.
-    variant
-        .require_simplex("tetrahedra", true)
-        .map_err(SolverError::InvalidInput)?;
-    let mesh = match &p.mesh {
-        Some(path) => format!(
-            "kind = \"gmsh\"\nfile = {}\ndimension = 3\n",
-            toml::Value::String(path.display().to_string())
-        ),
-        None => format!(
-            "kind = \"simplex\"\norigin = [0.0, 0.0, 0.0]\nsize = [{a:?}, {a:?}, {a:?}]\ncells = [{c}, 2, {c}]\npatches = true\n",
-            a = p.size,
-            c = p.cells
-        ),
-    };
-    let components = if p.clamped_top {
-        "[\"x\", \"y\", \"z\"]"
-    } else {
-        "[\"y\"]"
-    };
-    let roller = |set: &str, axis: &str| {
-        format!(
-            "[[boundary]]\nset = \"{set}\"\nkind = \"displacement\"\ndisplacement = {{ {axis} = 0.0 }}\n\n"
-        )
-    };
-    Ok(format!(
-        "[mesh]\n{mesh}\n\
-         [mesh.motion]\nkind = \"stretch\"\naxis = \"y\"\norigin = 0.0\nlength = {a:?}\nextension = {x:?}\ndriven = \"y1\"\ncomponents = {components}\n\n\
-         [[material]]\nname = \"cube\"\nmodel = \"von_mises\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\nyield_stress = {ys:?}\nhardening = {hd:?}\n\n\
-         [[body]]\nname = \"cube\"\nmaterial = \"cube\"\nregion = {{ box = {{ lower = [0.0, 0.0, 0.0], upper = [{a:?}, {a:?}, {a:?}] }} }}\nplacement = \"keast11\"\n\n\
-         {rx}{ry}{rz}{solver}predictor = {pred}\n",
-        a = p.size,
-        x = p.stretch,
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        ys = p.yield_stress,
-        hd = p.hardening,
-        rx = roller("x0", "x"),
-        ry = roller("y0", "y"),
-        rz = roller("z0", "z"),
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
-        pred = p.predictor,
-    ))
-}
-
-/// The stretch as a typed scene: the scene of [`scene_text`].
 ///
 /// # Errors
 /// [`SolverError::InvalidInput`] for a variant other than standard MPM or
@@ -264,13 +212,13 @@ pub fn scene(p: &StretchParams, variant: &Variant) -> Result<Scene, SolverError>
 /// The stretch's scene, built.
 ///
 /// # Errors
-/// As [`scene_text`], and the scene's own checks.
+/// As [`scene`], and the scene's own checks.
 pub fn problem(p: &StretchParams, variant: &Variant) -> Result<Problem<3>, SolverError> {
-    super::build_scene(&scene_text(p, variant)?, "stretch", 0)
+    super::build_scene(&scene(p, variant)?, "stretch", 0)
 }
 
 /// Runs the stretch with `variant` (standard MPM or F-patch; UL or PC):
-/// its scene ([`scene_text`]), built and run, measured against the
+/// its scene ([`scene`]), built and run, measured against the
 /// uniaxial stress.
 ///
 /// # Errors
