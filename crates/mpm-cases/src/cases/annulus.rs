@@ -110,6 +110,10 @@ impl crate::cases::Case for AnnulusCase {
     const ABOUT: &'static str = "Coombs 2020 §7.4: elastic annulus under torsion on triangles (manufactured solution, Fig. 19)";
     type Params = AnnulusParams;
 
+    fn scene(p: &AnnulusParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
+
     fn run(
         mut p: AnnulusParams,
         session: &crate::session::Session,

@@ -61,6 +61,10 @@ impl crate::cases::Case for CantileverCase {
         "Coombs 2020 §7.3: elastic cantilever under an end load (tip history, Newton residuals)";
     type Params = CantileverParams;
 
+    fn scene(p: &CantileverParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
+
     fn run(
         p: CantileverParams,
         session: &crate::session::Session,

@@ -61,6 +61,10 @@ impl crate::cases::Case for CollapseCase {
     const ABOUT: &'static str = "Coombs 2020 §7.5: elasto-plastic collapse of a block (Tables 6-7)";
     type Params = CollapseParams;
 
+    fn scene(p: &CollapseParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
+
     fn run(p: CollapseParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
         let problem = problem(&p, &p.variant())?;
         let mesh = super::grid_of(&problem, "the collapse runs on a grid")?;

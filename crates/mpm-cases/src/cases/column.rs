@@ -57,6 +57,10 @@ impl crate::cases::Case for ColumnCase {
     const ABOUT: &'static str = "Coombs 2020 §7.1: elastic column compacting under self weight (analytic eq. 41, error eq. 42)";
     type Params = ColumnParams;
 
+    fn scene(p: &ColumnParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
+
     fn run(p: ColumnParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
         let problem = problem(&p, &p.variant())?;
         let mesh = super::grid_of(&problem, "the column runs on a grid")?;

@@ -32,6 +32,13 @@ pub trait Case {
     /// Its parameters: every field a scene-file key with a default.
     type Params: Serialize + DeserializeOwned + Default;
 
+    /// The case's scene with `params` and the variant they name (what
+    /// `mpm scene --case NAME` prints).
+    ///
+    /// # Errors
+    /// Parameters that make no scene.
+    fn scene(params: &Self::Params) -> Result<crate::scene::Scene, mpm_solver::SolverError>;
+
     /// Runs the case with `params` in `session`, writing its outputs and
     /// `summary.json` (its error against the reference and its results).
     ///
@@ -53,6 +60,9 @@ pub struct CaseEntry {
     /// overrides and runs.
     pub run:
         fn(text: &str, origin: &str, set: &[String], session: &Session) -> Result<(), CasesError>,
+    /// The case's scene with the default parameters and the overrides, as
+    /// the text of a scene file.
+    pub scene: fn(set: &[String]) -> Result<String, CasesError>,
 }
 
 impl CaseEntry {
@@ -63,6 +73,7 @@ impl CaseEntry {
             about: C::ABOUT,
             defaults: defaults::<C>,
             run: run::<C>,
+            scene: scene::<C>,
         }
     }
 }
@@ -78,6 +89,14 @@ fn run<C: Case>(
     session: &Session,
 ) -> Result<(), CasesError> {
     C::run(parse_scene(text, origin, set)?, session)
+}
+
+fn scene<C: Case>(set: &[String]) -> Result<String, CasesError> {
+    let params: C::Params = parse_scene("", "command line", set)?;
+    toml::to_string(&C::scene(&params)?).map_err(|source| CasesError::SceneToml {
+        case: C::NAME,
+        source,
+    })
 }
 
 /// Every built-in case, in the order `mpm list` shows them.

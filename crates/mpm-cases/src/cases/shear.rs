@@ -89,6 +89,10 @@ impl crate::cases::Case for ShearCase {
     const ABOUT: &'static str = "Coombs 2020 §7.2: simple shear of a unit square, elastic or perfectly plastic (homogeneous)";
     type Params = ShearParams;
 
+    fn scene(p: &ShearParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
+
     fn run(p: ShearParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
         let problem = problem(&p, &p.variant())?;
         let mesh = super::grid_of(&problem, "the shear runs on a grid")?;

@@ -90,6 +90,10 @@ impl crate::cases::Case for StretchCase {
         "Wang 2021 §5.3: simple stretch of a cube on tetrahedra with a moving mesh (Table 1)";
     type Params = StretchParams;
 
+    fn scene(p: &StretchParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
+
     fn run(
         mut p: StretchParams,
         session: &crate::session::Session,
