@@ -19,7 +19,7 @@ use mpm_solver::{SolverError, StepReport};
 use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
 use crate::scene::format::{
-    BodySpec, BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, SolverSpec,
+    BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, SolverSpec,
 };
 use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
@@ -126,21 +126,14 @@ pub fn scene(p: &CollapseParams, variant: &Variant) -> Result<Scene, SolverError
         1.0,
     )
     .with_yield_stress(p.yield_stress);
-    Ok(Scene::new(
-        MeshSpec::grid([0.0, 0.0], [p.grid_width, p.height + p.h], [nx, ny + 1]),
-        vec![material],
-        vec![BodySpec::block(
-            "block",
-            "block",
-            [0.0, 0.0],
-            [p.width, p.height],
-            p.points_per_cell,
-        )],
+    let mesh = MeshSpec::grid([0.0, 0.0], [p.grid_width, p.height + p.h], [nx, ny + 1]);
+    Ok(
+        super::one_block(mesh, material, [p.width, p.height], p.points_per_cell)
+            .with_boundary(BoundarySpec::on("x_min", BoundaryKind::Roller))
+            .with_boundary(BoundarySpec::on("y_min", BoundaryKind::Roller))
+            .with_load(LoadSpec::gravity([0.0, -p.body_force]))
+            .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)),
     )
-    .with_boundary(BoundarySpec::on("x_min", BoundaryKind::Roller))
-    .with_boundary(BoundarySpec::on("y_min", BoundaryKind::Roller))
-    .with_load(LoadSpec::gravity([0.0, -p.body_force]))
-    .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)))
 }
 
 /// The collapse's scene, built.

@@ -13,7 +13,7 @@ use mpm_solver::SolverError;
 use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
 use crate::scene::format::{
-    BodySpec, BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, SolverSpec,
+    BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, SolverSpec,
 };
 use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
@@ -137,22 +137,15 @@ pub fn scene(p: &ColumnParams, variant: &Variant) -> Result<Scene, SolverError> 
         Some(y) => material.with_yield_stress(y).with_hardening(p.hardening),
         None => material,
     };
-    Ok(Scene::new(
-        MeshSpec::grid([0.0, 0.0], [p.h, p.height], [1, cells_y]),
-        vec![material],
-        vec![BodySpec::block(
-            "column",
-            "column",
-            [0.0, 0.0],
-            [p.h, p.height],
-            p.points_per_cell,
-        )],
+    let mesh = MeshSpec::grid([0.0, 0.0], [p.h, p.height], [1, cells_y]);
+    Ok(
+        super::one_block(mesh, material, [p.h, p.height], p.points_per_cell)
+            .with_boundary(BoundarySpec::on("x_min", BoundaryKind::Roller))
+            .with_boundary(BoundarySpec::on("x_max", BoundaryKind::Roller))
+            .with_boundary(BoundarySpec::on("y_min", BoundaryKind::Roller))
+            .with_load(LoadSpec::gravity([0.0, -p.gravity]))
+            .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)),
     )
-    .with_boundary(BoundarySpec::on("x_min", BoundaryKind::Roller))
-    .with_boundary(BoundarySpec::on("x_max", BoundaryKind::Roller))
-    .with_boundary(BoundarySpec::on("y_min", BoundaryKind::Roller))
-    .with_load(LoadSpec::gravity([0.0, -p.gravity]))
-    .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)))
 }
 
 /// The column's scene, built.

@@ -211,6 +211,21 @@ pub(crate) fn cells_along(
     Ok(n as usize)
 }
 
+/// The scene of one body of `material`, named as the material, filling
+/// the box from the origin to `upper` with `points_per_cell` per axis on
+/// the grid `mesh` (the column's and the collapse's).
+pub(crate) fn one_block(
+    mesh: crate::scene::format::MeshSpec,
+    material: crate::scene::format::MaterialSpec,
+    upper: [f64; 2],
+    points_per_cell: usize,
+) -> crate::scene::Scene {
+    let name = material.name.get_ref().clone();
+    let body =
+        crate::scene::format::BodySpec::block(&name, &name, [0.0, 0.0], upper, points_per_cell);
+    crate::scene::Scene::new(mesh, vec![material], vec![body])
+}
+
 /// Builds a case's typed `scene` (named `case` in errors): a case's
 /// parameters that make no valid scene are refused with the scene's
 /// message, which names the case's scene (it has no file, so no line and
