@@ -55,6 +55,14 @@ pub enum CasesError {
         /// The serialiser's error.
         source: toml::ser::Error,
     },
+    /// A case's scene cannot be written as TOML.
+    #[error("cannot write the {case} case's scene as TOML: {source}")]
+    SceneToml {
+        /// The case.
+        case: &'static str,
+        /// The serialiser's error.
+        source: toml::ser::Error,
+    },
     /// A scene file, an override or the problem it describes is invalid.
     #[error(transparent)]
     Scene(#[from] SceneError),

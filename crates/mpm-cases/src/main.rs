@@ -4,6 +4,7 @@
 //! mpm list
 //! mpm run scene.toml [--set key=value ...] [--out DIR] [--threads N]
 //! mpm run --case column [--set key=value ...] [--out DIR] [--threads N]
+//! mpm scene --case column [--set key=value ...] > column.toml
 //! ```
 
 use std::path::PathBuf;
@@ -31,6 +32,16 @@ struct Cli {
 enum Command {
     /// List the cases and their parameters (with defaults).
     List,
+    /// Print a case's scene as a scene file (TOML), to start a scene file
+    /// from a case: `mpm scene --case column --set h=1.5625 > my.toml`.
+    Scene {
+        /// The case.
+        #[arg(long)]
+        case: String,
+        /// Override a case parameter, e.g. `--set h=1.5625 --set basis=gimp`.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
     /// Run a scene file or a named case.
     Run {
         /// Scene file (TOML): a whole problem (`[mesh]`, `[[material]]`,
@@ -104,11 +115,18 @@ fn run_cli(cli: Cli) -> Result<()> {
                     .collect::<Vec<_>>()
                     .join(" | ")
             )?;
-            // A closed pipe (`mpm list | head`) is not an error.
-            match std::io::Write::write_all(&mut std::io::stdout(), text.as_bytes()) {
-                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
-                _ => Ok(()),
-            }
+            print(&text)
+        }
+        Command::Scene { case, set } => {
+            let entry = find_case(&case)?;
+            let scene = (entry.scene)(&set)?;
+            print(&format!(
+                "# The {case} case's scene (`mpm scene --case {case}{}`): {}.\n# `mpm run` runs this file as a scene, without the case's check against its reference.\n\n{scene}",
+                set.iter()
+                    .map(|s| format!(" --set {s}"))
+                    .collect::<String>(),
+                entry.about
+            ))
         }
         Command::Run {
             scene,
@@ -161,16 +179,7 @@ fn run_cli(cli: Cli) -> Result<()> {
             let case = if is_scene {
                 None
             } else {
-                Some(cases::find(&name).ok_or_else(|| {
-                    anyhow!(
-                        "unknown case `{name}`; cases: {}",
-                        cases::ALL
-                            .iter()
-                            .map(|c| c.name)
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    )
-                })?)
+                Some(find_case(&name)?)
             };
             let run = || match case {
                 None => mpm_cases::scene::run_file(&text, &origin, &set, &session),
@@ -198,5 +207,28 @@ fn run_cli(cli: Cli) -> Result<()> {
                 ok => ok,
             }
         }
+    }
+}
+
+/// The registered case `name`, or an error listing the cases.
+fn find_case(name: &str) -> Result<&'static cases::CaseEntry> {
+    cases::find(name).ok_or_else(|| {
+        anyhow!(
+            "unknown case `{name}`; cases: {}",
+            cases::ALL
+                .iter()
+                .map(|c| c.name)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    })
+}
+
+/// Writes `text` to standard output; a closed pipe (`mpm list | head`) is
+/// not an error.
+fn print(text: &str) -> Result<()> {
+    match std::io::Write::write_all(&mut std::io::stdout(), text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
     }
 }

@@ -39,6 +39,82 @@ fn list_names_every_case() {
     }
 }
 
+/// `mpm scene --case NAME` prints the case's scene as a scene file: the
+/// case's typed scene with the overrides, which `mpm run` runs as a scene.
+#[test]
+fn scene_prints_a_case_as_a_scene_file() {
+    use mpm_cases::cases::column::{self, ColumnParams};
+    use mpm_cases::variant::BasisKind;
+    for case in [
+        "column",
+        "shear",
+        "cantilever",
+        "annulus",
+        "collapse",
+        "stretch",
+    ] {
+        let (ok, out, err) = mpm(&["scene", "--case", case]);
+        assert!(ok, "{case}: {err}");
+        let (scene, _) = mpm_cases::scene::parse(&out, case, &[]).unwrap();
+        assert_eq!(scene.bodies.len(), 1, "{case}");
+    }
+    let (ok, out, err) = mpm(&[
+        "scene",
+        "--case",
+        "column",
+        "--set",
+        "h=12.5",
+        "--set",
+        "basis=gimp",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.starts_with(
+            "# The column case's scene (`mpm scene --case column --set h=12.5 --set basis=gimp`)"
+        ),
+        "{out}"
+    );
+    let params = ColumnParams {
+        h: 12.5,
+        basis: BasisKind::Gimp,
+        ..ColumnParams::default()
+    };
+    let (scene, _) = mpm_cases::scene::parse(&out, "column.toml", &[]).unwrap();
+    assert_eq!(scene, column::scene(&params, &params.variant()).unwrap());
+
+    let dir = temp_dir("scene-of-case");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("column.toml");
+    std::fs::write(&file, &out).unwrap();
+    let (ok, _, err) = mpm(&[
+        "run",
+        file.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["material_points"], 2 * 2 * 4);
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    for (args, expected) in [
+        (vec!["scene", "--case", "nope"], "unknown case `nope`"),
+        (
+            vec!["scene", "--case", "column", "--set", "h=3"],
+            "must divide",
+        ),
+        (
+            vec!["scene", "--case", "column", "--set", "hh=3"],
+            "unknown field",
+        ),
+    ] {
+        let (ok, _, err) = mpm(&args);
+        assert!(!ok && err.contains(expected), "{args:?}: {err}");
+    }
+}
+
 #[test]
 fn the_issue_command_line_runs_and_writes_every_output() {
     let dir = temp_dir("column");

@@ -76,8 +76,9 @@ pub enum MeshKind {
 }
 
 /// `[mesh]`: a regular grid over the box `origin .. origin + size`, or a
-/// Gmsh file.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+/// Gmsh file. The default is an empty `[mesh]` table: every key the
+/// file may leave out, left out.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
     /// The kind of mesh (`grid` or `gmsh`).
@@ -307,7 +308,7 @@ pub enum Placement {
     Gauss4,
 }
 
-fn default_points_per_cell() -> Spanned<usize> {
+pub(crate) fn default_points_per_cell() -> Spanned<usize> {
     Spanned::new(0..0, 2)
 }
 

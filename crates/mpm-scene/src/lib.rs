@@ -7,7 +7,8 @@
 //! [`source`] parses it with its `--set` overrides and keeps every key's
 //! place in the file; [`build`] checks it across sections and builds the
 //! grid, points, conditions and loads, every error naming its place in the
-//! file or the override it comes from. The names a scene chooses by —
+//! file or the override it comes from; [`typed`] writes a scene in Rust
+//! instead (the built-in cases), which builds the same way. The names a scene chooses by —
 //! the variant ([`variant`]) and the registered laws ([`material`]) — live
 //! here too; running a problem is the `mpm-dispatch` crate's concern. The
 //! key-by-key reference is the guide page `docs/src/guide/scenes.md`.
@@ -21,6 +22,7 @@ pub mod material;
 pub mod region;
 pub use variant::rules;
 pub mod source;
+pub mod typed;
 pub mod variant;
 
 pub use build::{

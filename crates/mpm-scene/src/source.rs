@@ -293,7 +293,8 @@ fn first_non_finite_in_table(table: &DeTable<'_>) -> Option<Range<usize>> {
 
 /// Where a scene came from: its text and origin and the overrides applied
 /// to it, which are given spans past the end of the text. Maps the byte
-/// spans of the parsed document (`toml::Spanned` fields) to places.
+/// spans of the parsed document (`toml::Spanned` fields) to places — or,
+/// for a scene written in Rust ([`Self::typed`]), to its origin alone.
 #[derive(Debug, Clone, Default)]
 pub struct SceneSource {
     text: String,
@@ -301,6 +302,8 @@ pub struct SceneSource {
     overrides: Vec<String>,
     /// Start of each override's virtual span.
     starts: Vec<usize>,
+    /// No text: the scene was written in Rust ([`crate::typed`]).
+    typed: bool,
 }
 
 impl SceneSource {
@@ -316,6 +319,20 @@ impl SceneSource {
             origin: origin.to_owned(),
             overrides: overrides.to_vec(),
             starts,
+            typed: false,
+        }
+    }
+
+    /// The source of a scene written in Rust ([`crate::typed`]), named
+    /// `origin` (e.g. "the column case's scene"): it has no file, so every
+    /// error, whatever its span, is [`SceneError::SceneUnlocated`] —
+    /// `origin: message`, no line and column of a file that does not
+    /// exist.
+    pub fn typed(origin: &str) -> Self {
+        Self {
+            origin: origin.to_owned(),
+            typed: true,
+            ..Self::default()
         }
     }
 
@@ -332,10 +349,10 @@ impl SceneSource {
 
     /// An error at `span` of the parsed document: `origin:line:column:
     /// message` in the file, or naming the override the span belongs to;
-    /// without a span, the origin only.
+    /// without a span, or for a [`Self::typed`] source, the origin only.
     pub fn error(&self, span: Option<Range<usize>>, message: &str) -> SceneError {
         let message = message.trim_end().to_owned();
-        let Some(span) = span else {
+        let Some(span) = span.filter(|_| !self.typed) else {
             return SceneError::SceneUnlocated {
                 origin: self.origin.clone(),
                 message,
@@ -394,7 +411,33 @@ fn line_column(text: &str, offset: usize) -> (usize, usize) {
 
 #[cfg(test)]
 mod tests {
-    use super::line_column;
+    use super::{SceneSource, line_column};
+    use crate::SceneError;
+
+    /// A scene written in Rust has no file: an error at any span of it
+    /// names the origin, without a line and column.
+    #[test]
+    fn a_typed_source_reports_errors_unlocated() {
+        let source = SceneSource::typed("the column case's scene");
+        for span in [Some(0..0), Some(12..20), None] {
+            let e = source.error(span.clone(), "density must be positive\n");
+            assert!(
+                matches!(&e, SceneError::SceneUnlocated { origin, message }
+                    if origin == "the column case's scene" && message == "density must be positive"),
+                "{span:?}: {e:?}"
+            );
+            assert_eq!(
+                e.to_string(),
+                "the column case's scene: density must be positive"
+            );
+        }
+        let at = source.at(&toml::Spanned::new(3..7, 1.0), "here");
+        assert_eq!(at.to_string(), "the column case's scene: here");
+        assert_eq!(source.origin(), "the column case's scene");
+        // A text source of the same origin locates the same span.
+        let text = SceneSource::new("a = 1\nb = 2\n", "s.toml", &[]);
+        assert_eq!(text.error(Some(6..7), "m").to_string(), "s.toml:2:1: m");
+    }
 
     #[test]
     fn line_column_is_one_based_in_characters() {

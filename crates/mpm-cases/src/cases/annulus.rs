@@ -56,8 +56,12 @@ use std::path::PathBuf;
 use mpm_solver::{SolverError, StepReport};
 use nalgebra::Vector2;
 
+use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    BodySpec, BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, RegionSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 pub use crate::manufactured::Torsion;
@@ -105,6 +109,10 @@ impl crate::cases::Case for AnnulusCase {
     const NAME: &'static str = "annulus";
     const ABOUT: &'static str = "Coombs 2020 §7.4: elastic annulus under torsion on triangles (manufactured solution, Fig. 19)";
     type Params = AnnulusParams;
+
+    fn scene(p: &AnnulusParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
 
     fn run(
         mut p: AnnulusParams,
@@ -157,7 +165,7 @@ pub struct AnnulusResult {
     pub element_size: f64,
 }
 
-/// The annulus as a scene (the text of `scenes/coombs2020_annulus.toml`
+/// The annulus as a typed scene (the scene of `scenes/coombs2020_annulus.toml`
 /// with the parameters filled in): the generated annulus mesh of element
 /// size about `h` (round((R_o − R_i)/h) layers, at least 2, and
 /// round(2π R_o/h) nodes per ring, at least 8), or the Gmsh file `mesh`
@@ -167,15 +175,12 @@ pub struct AnnulusResult {
 /// # Errors
 /// [`SolverError::InvalidInput`] for a non-positive `h` or a variant other
 /// than standard MPM.
-pub fn scene_text(p: &AnnulusParams, variant: &Variant) -> Result<String, SolverError> {
+pub fn scene(p: &AnnulusParams, variant: &Variant) -> Result<Scene, SolverError> {
     variant
         .require_standard_mpm("triangles")
         .map_err(SolverError::InvalidInput)?;
     let mesh = match &p.mesh {
-        Some(path) => format!(
-            "kind = \"gmsh\"\nfile = {}\ndimension = 2\n",
-            toml::Value::String(path.display().to_string())
-        ),
+        Some(path) => MeshSpec::gmsh(path.display().to_string(), 2),
         None => {
             if !(p.h > 0.0 && p.h.is_finite()) {
                 return Err(SolverError::InvalidInput(format!(
@@ -187,39 +192,40 @@ pub fn scene_text(p: &AnnulusParams, variant: &Variant) -> Result<String, Solver
             let ring = (2.0 * std::f64::consts::PI * p.outer_radius / p.h)
                 .round()
                 .max(8.0) as usize;
-            format!(
-                "kind = \"annulus\"\ninner_radius = {:?}\nouter_radius = {:?}\nlayers = {radial}\nring_nodes = {ring}\njitter = {:?}\nseed = 1\n",
-                p.inner_radius, p.outer_radius, p.jitter
-            )
+            MeshSpec::annulus(p.inner_radius, p.outer_radius, radial, ring).with_jitter(p.jitter, 1)
         }
     };
-    Ok(format!(
-        "[mesh]\n{mesh}\n\
-         [[material]]\nname = \"annulus\"\nmodel = \"hencky\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\n\n\
-         [[body]]\nname = \"annulus\"\nmaterial = \"annulus\"\nregion = {{ group = \"domain\" }}\npoints_per_cell = {ppe}\n\n\
-         [[boundary]]\nset = \"inner\"\nkind = \"fixed\"\n\n\
-         [[boundary]]\nset = \"outer\"\nkind = \"fixed\"\n\n\
-         [[load]]\nkind = \"manufactured\"\nfield = \"annulus_torsion\"\nparameters = {{ inner_radius = {ri:?}, outer_radius = {ro:?}, alpha = {alpha:?} }}\n\n{solver}",
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        ppe = p.points_per_element,
-        ri = p.inner_radius,
-        ro = p.outer_radius,
-        alpha = p.alpha,
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
-    ))
+    let material = MaterialSpec::new(
+        "annulus",
+        MaterialModel::Hencky,
+        p.youngs_modulus,
+        p.poisson_ratio,
+        0.0,
+    );
+    let body = BodySpec::new("annulus", "annulus", RegionSpec::group("domain"))
+        .with_points_per_cell(p.points_per_element);
+    let torsion = [
+        ("inner_radius", p.inner_radius),
+        ("outer_radius", p.outer_radius),
+        ("alpha", p.alpha),
+    ];
+    Ok(Scene::new(mesh, vec![material], vec![body])
+        .with_boundary(BoundarySpec::on("inner", BoundaryKind::Fixed))
+        .with_boundary(BoundarySpec::on("outer", BoundaryKind::Fixed))
+        .with_load(LoadSpec::manufactured("annulus_torsion", torsion))
+        .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)))
 }
 
 /// The annulus's scene, built.
 ///
 /// # Errors
-/// As [`scene_text`], and the scene's own checks.
+/// As [`scene`], and the scene's own checks.
 pub fn problem(p: &AnnulusParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(&scene_text(p, variant)?, "annulus", 0)
+    super::build_scene(&scene(p, variant)?, "annulus", 0)
 }
 
 /// Runs the annulus with `variant` (standard MPM on the triangles; UL or
-/// PC): its scene ([`scene_text`]), built and run, measured against the
+/// PC): its scene ([`scene`]), built and run, measured against the
 /// exact displacement.
 ///
 /// # Errors

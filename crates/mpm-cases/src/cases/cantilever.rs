@@ -11,8 +11,13 @@
 
 use mpm_solver::{SolverError, StepReport};
 
+use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    Axes, BodySpec, BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, NodeSetSpec,
+    RegionSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -55,6 +60,10 @@ impl crate::cases::Case for CantileverCase {
     const ABOUT: &'static str =
         "Coombs 2020 §7.3: elastic cantilever under an end load (tip history, Newton residuals)";
     type Params = CantileverParams;
+
+    fn scene(p: &CantileverParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
 
     fn run(
         p: CantileverParams,
@@ -108,7 +117,7 @@ pub struct CantileverResult {
     pub material_points: usize,
 }
 
-/// The cantilever as a scene (the text of
+/// The cantilever as a typed scene (the scene of
 /// `scenes/coombs2020_cantilever.toml` with the parameters and variant
 /// filled in): a grid with room below for a tip deflection of about the
 /// beam length and the padding the basis needs; the root a wall (every
@@ -122,7 +131,7 @@ pub struct CantileverResult {
 /// # Errors
 /// [`SolverError::InvalidInput`] unless `h` divides half the depth and the
 /// length and `points_per_cell` is even.
-pub fn scene_text(p: &CantileverParams, variant: &Variant) -> Result<String, SolverError> {
+pub fn scene(p: &CantileverParams, variant: &Variant) -> Result<Scene, SolverError> {
     let half = p.depth / 2.0;
     let k = (half / p.h).round();
     if k < 1.0
@@ -143,51 +152,62 @@ pub fn scene_text(p: &CantileverParams, variant: &Variant) -> Result<String, Sol
     ];
     let (tol, step) = (1e-9 * p.h, p.h / p.points_per_cell as f64);
     let (y_lo, y_hi) = (-below - 2.0 * p.h, p.depth + 2.0 * p.h + 0.5);
-    Ok(format!(
-        "[mesh]\norigin = [0.0, {oy:?}]\nsize = [{sx:?}, {sy:?}]\ncells = [{cx}, {cy}]\n\n\
-         [[material]]\nname = \"beam\"\nmodel = \"hencky\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\n\n\
-         [[body]]\nname = \"beam\"\nmaterial = \"beam\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [{l:?}, {d:?}] }} }}\npoints_per_cell = {ppc}\nlattice_origin = [0.0, 0.0]\n\n\
-         [[node_set]]\nname = \"root\"\nregion = {{ box = {{ lower = [{mt:?}, {y_lo:?}], upper = [{tol:?}, {y_hi:?}] }} }}\n\n\
-         [[node_set]]\nname = \"neutral_axis_at_root\"\nregion = {{ box = {{ lower = [{mt:?}, {na_lo:?}], upper = [{tol:?}, {na_hi:?}] }} }}\n\n\
-         [[boundary]]\nset = \"root\"\nkind = \"displacement\"\ndisplacement = {{ x = 0.0 }}\n\n\
-         [[boundary]]\nset = \"neutral_axis_at_root\"\nkind = \"fixed\"\n\n\
-         [[load]]\nkind = \"point\"\nregion = {{ box = {{ lower = [{lx:?}, {ly_lo:?}], upper = [{l:?}, {ly_hi:?}] }} }}\nforce = [0.0, {f:?}]\n\n{solver}",
-        oy = -below,
-        sx = cells[0] as f64 * p.h,
-        sy = cells[1] as f64 * p.h,
-        cx = cells[0],
-        cy = cells[1],
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        l = p.length,
-        d = p.depth,
-        ppc = p.points_per_cell,
-        mt = -tol,
-        na_lo = half - tol,
-        na_hi = half + tol,
-        lx = p.length - step,
-        ly_lo = half - step,
-        ly_hi = half + step,
-        f = -p.load,
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
+    let material = MaterialSpec::new(
+        "beam",
+        MaterialModel::Hencky,
+        p.youngs_modulus,
+        p.poisson_ratio,
+        0.0,
+    );
+    let body = BodySpec::block(
+        "beam",
+        "beam",
+        [0.0, 0.0],
+        [p.length, p.depth],
+        p.points_per_cell,
+    )
+    .with_lattice_origin([0.0, 0.0]);
+    let end = RegionSpec::box_between([p.length - step, half - step], [p.length, half + step]);
+    Ok(Scene::new(
+        MeshSpec::grid(
+            [0.0, -below],
+            [cells[0] as f64 * p.h, cells[1] as f64 * p.h],
+            cells,
+        ),
+        vec![material],
+        vec![body],
+    )
+    .with_node_set(NodeSetSpec::inside(
+        "root",
+        RegionSpec::box_between([-tol, y_lo], [tol, y_hi]),
     ))
+    .with_node_set(NodeSetSpec::inside(
+        "neutral_axis_at_root",
+        RegionSpec::box_between([-tol, half - tol], [tol, half + tol]),
+    ))
+    .with_boundary(
+        BoundarySpec::on("root", BoundaryKind::Displacement)
+            .with_displacement(Axes::default().with_x(0.0)),
+    )
+    .with_boundary(BoundarySpec::on(
+        "neutral_axis_at_root",
+        BoundaryKind::Fixed,
+    ))
+    .with_load(LoadSpec::point_in(end, [0.0, -p.load]))
+    .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)))
 }
 
 /// The cantilever's scene, built, and the indices of its two loaded
 /// points.
 ///
 /// # Errors
-/// As [`scene_text`], the scene's own checks, and an end that does not
+/// As [`scene`], the scene's own checks, and an end that does not
 /// hold exactly two points.
 pub fn problem(
     p: &CantileverParams,
     variant: &Variant,
 ) -> Result<(Problem<2>, [usize; 2]), SolverError> {
-    let problem = super::build_scene(
-        &scene_text(p, variant)?,
-        "cantilever",
-        variant.basis.padding(),
-    )?;
+    let problem = super::build_scene(&scene(p, variant)?, "cantilever", variant.basis.padding())?;
     match problem.point_forces.as_slice() {
         [(a, _), (b, _)] => {
             let loaded = [*a, *b];
@@ -231,7 +251,7 @@ where
     })
 }
 
-/// Runs the cantilever with `variant`: its scene ([`scene_text`]), built
+/// Runs the cantilever with `variant`: its scene ([`scene`]), built
 /// and run.
 ///
 /// # Errors

@@ -16,8 +16,12 @@
 
 use mpm_solver::{SolverError, StepReport};
 
+use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -56,6 +60,10 @@ impl crate::cases::Case for CollapseCase {
     const NAME: &'static str = "collapse";
     const ABOUT: &'static str = "Coombs 2020 §7.5: elasto-plastic collapse of a block (Tables 6-7)";
     type Params = CollapseParams;
+
+    fn scene(p: &CollapseParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
 
     fn run(p: CollapseParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
         let problem = problem(&p, &p.variant())?;
@@ -97,7 +105,7 @@ pub struct CollapseResult {
     pub material_points: usize,
 }
 
-/// The collapse as a scene (the text of `scenes/coombs2020_collapse.toml`
+/// The collapse as a typed scene (the scene of `scenes/coombs2020_collapse.toml`
 /// with the parameters and variant filled in): a grid of `grid_width` by
 /// `height + h` with the padding the basis needs, rollers on the base and
 /// the symmetry line (their padding nodes held alike), the body force as
@@ -106,54 +114,34 @@ pub struct CollapseResult {
 /// # Errors
 /// [`SolverError::InvalidInput`] when `h` does not divide the widths and
 /// the height.
-pub fn scene_text(p: &CollapseParams, variant: &Variant) -> Result<String, SolverError> {
-    let cells = |len: f64, what: &str| {
-        let n = (len / p.h).round();
-        if n < 1.0 || (n * p.h - len).abs() > 1e-9 * len {
-            Err(SolverError::InvalidInput(format!(
-                "h = {} must divide the {what} {len}",
-                p.h
-            )))
-        } else {
-            Ok(n as usize)
-        }
-    };
-    let (nx, ny) = (
-        cells(p.grid_width, "grid width")?,
-        cells(p.height, "height")?,
-    );
-    cells(p.width, "block width")?;
-    Ok(format!(
-        "[mesh]\norigin = [0.0, 0.0]\nsize = [{gw:?}, {gh:?}]\ncells = [{nx}, {cy}]\n\n\
-         [[material]]\nname = \"block\"\nmodel = \"von_mises\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 1.0\nyield_stress = {ys:?}\n\n\
-         [[body]]\nname = \"block\"\nmaterial = \"block\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [{w:?}, {hh:?}] }} }}\npoints_per_cell = {ppc}\n\n\
-         [[boundary]]\nset = \"x_min\"\nkind = \"roller\"\n\n\
-         [[boundary]]\nset = \"y_min\"\nkind = \"roller\"\n\n\
-         [[load]]\nkind = \"gravity\"\nacceleration = [0.0, {g:?}]\n\n{solver}",
-        gw = p.grid_width,
-        gh = p.height + p.h,
-        cy = ny + 1,
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        ys = p.yield_stress,
-        w = p.width,
-        hh = p.height,
-        ppc = p.points_per_cell,
-        g = -p.body_force,
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
-    ))
+pub fn scene(p: &CollapseParams, variant: &Variant) -> Result<Scene, SolverError> {
+    let nx = super::cells_along(p.h, p.grid_width, "the grid width")?;
+    let ny = super::cells_along(p.h, p.height, "the height")?;
+    super::cells_along(p.h, p.width, "the block width")?;
+    let material = MaterialSpec::new(
+        "block",
+        MaterialModel::VonMises,
+        p.youngs_modulus,
+        p.poisson_ratio,
+        1.0,
+    )
+    .with_yield_stress(p.yield_stress);
+    let mesh = MeshSpec::grid([0.0, 0.0], [p.grid_width, p.height + p.h], [nx, ny + 1]);
+    Ok(
+        super::one_block(mesh, material, [p.width, p.height], p.points_per_cell)
+            .with_boundary(BoundarySpec::on("x_min", BoundaryKind::Roller))
+            .with_boundary(BoundarySpec::on("y_min", BoundaryKind::Roller))
+            .with_load(LoadSpec::gravity([0.0, -p.body_force]))
+            .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)),
+    )
 }
 
 /// The collapse's scene, built.
 ///
 /// # Errors
-/// As [`scene_text`], and the scene's own checks.
+/// As [`scene`], and the scene's own checks.
 pub fn problem(p: &CollapseParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(
-        &scene_text(p, variant)?,
-        "collapse",
-        variant.basis.padding(),
-    )
+    super::build_scene(&scene(p, variant)?, "collapse", variant.basis.padding())
 }
 
 /// Runs the built collapse and measures the body's extent.
@@ -195,7 +183,7 @@ where
     })
 }
 
-/// Runs the collapse with `variant`: its scene ([`scene_text`]), built and
+/// Runs the collapse with `variant`: its scene ([`scene`]), built and
 /// run.
 ///
 /// # Errors

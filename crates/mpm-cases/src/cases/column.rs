@@ -12,7 +12,10 @@ use mpm_solver::SolverError;
 
 use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -53,6 +56,10 @@ impl crate::cases::Case for ColumnCase {
     const NAME: &'static str = "column";
     const ABOUT: &'static str = "Coombs 2020 §7.1: elastic column compacting under self weight (analytic eq. 41, error eq. 42)";
     type Params = ColumnParams;
+
+    fn scene(p: &ColumnParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
 
     fn run(p: ColumnParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
         let problem = problem(&p, &p.variant())?;
@@ -108,7 +115,7 @@ pub struct ColumnResult {
     pub material_points: usize,
 }
 
-/// The column as a scene (the text of `scenes/coombs2020_column.toml`
+/// The column as a typed scene (the scene of `scenes/coombs2020_column.toml`
 /// with the parameters and variant filled in): a grid one cell wide that
 /// spans the column exactly, with the padding the basis needs; every node
 /// held horizontally (both faces of the one-cell grid, padding included),
@@ -117,44 +124,36 @@ pub struct ColumnResult {
 ///
 /// # Errors
 /// [`SolverError::InvalidInput`] when `h` does not divide the height.
-pub fn scene_text(p: &ColumnParams, variant: &Variant) -> Result<String, SolverError> {
-    let cells_y = (p.height / p.h).round() as usize;
-    if cells_y == 0 || (cells_y as f64 * p.h - p.height).abs() > 1e-9 * p.height {
-        return Err(SolverError::InvalidInput(format!(
-            "h = {} must divide the column height {}",
-            p.h, p.height
-        )));
-    }
-    let plastic = match p.yield_stress {
-        Some(y) => format!("yield_stress = {y:?}\nhardening = {:?}\n", p.hardening),
-        None => String::new(),
+pub fn scene(p: &ColumnParams, variant: &Variant) -> Result<Scene, SolverError> {
+    let cells_y = super::cells_along(p.h, p.height, "the column height")?;
+    let material = MaterialSpec::new(
+        "column",
+        p.material,
+        p.youngs_modulus,
+        p.poisson_ratio,
+        p.density,
+    );
+    let material = match p.yield_stress {
+        Some(y) => material.with_yield_stress(y).with_hardening(p.hardening),
+        None => material,
     };
-    Ok(format!(
-        "[mesh]\norigin = [0.0, 0.0]\nsize = [{h:?}, {height:?}]\ncells = [1, {cells_y}]\n\n\
-         [[material]]\nname = \"column\"\nmodel = \"{model}\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = {rho:?}\n{plastic}\n\
-         [[body]]\nname = \"column\"\nmaterial = \"column\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [{h:?}, {height:?}] }} }}\npoints_per_cell = {ppc}\n\n\
-         [[boundary]]\nset = \"x_min\"\nkind = \"roller\"\n\n\
-         [[boundary]]\nset = \"x_max\"\nkind = \"roller\"\n\n\
-         [[boundary]]\nset = \"y_min\"\nkind = \"roller\"\n\n\
-         [[load]]\nkind = \"gravity\"\nacceleration = [0.0, {g:?}]\n\n{solver}",
-        h = p.h,
-        height = p.height,
-        model = p.material,
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        rho = p.density,
-        ppc = p.points_per_cell,
-        g = -p.gravity,
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
-    ))
+    let mesh = MeshSpec::grid([0.0, 0.0], [p.h, p.height], [1, cells_y]);
+    Ok(
+        super::one_block(mesh, material, [p.h, p.height], p.points_per_cell)
+            .with_boundary(BoundarySpec::on("x_min", BoundaryKind::Roller))
+            .with_boundary(BoundarySpec::on("x_max", BoundaryKind::Roller))
+            .with_boundary(BoundarySpec::on("y_min", BoundaryKind::Roller))
+            .with_load(LoadSpec::gravity([0.0, -p.gravity]))
+            .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)),
+    )
 }
 
 /// The column's scene, built.
 ///
 /// # Errors
-/// As [`scene_text`], and the scene's own checks.
+/// As [`scene`], and the scene's own checks.
 pub fn problem(p: &ColumnParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(&scene_text(p, variant)?, "column", variant.basis.padding())
+    super::build_scene(&scene(p, variant)?, "column", variant.basis.padding())
 }
 
 /// Runs the built column and measures it against eq. (42).
@@ -180,7 +179,7 @@ where
     })
 }
 
-/// Runs the column with `variant`: its scene ([`scene_text`]), built and
+/// Runs the column with `variant`: its scene ([`scene`]), built and
 /// run, measured against eq. (42).
 ///
 /// # Errors

@@ -18,6 +18,8 @@ pub mod annulus;
 pub mod cantilever;
 pub mod collapse;
 pub mod column;
+#[cfg(test)]
+mod scene_tests;
 pub mod shear;
 pub mod stretch;
 
@@ -29,6 +31,13 @@ pub trait Case {
     const ABOUT: &'static str;
     /// Its parameters: every field a scene-file key with a default.
     type Params: Serialize + DeserializeOwned + Default;
+
+    /// The case's scene with `params` and the variant they name (what
+    /// `mpm scene --case NAME` prints).
+    ///
+    /// # Errors
+    /// Parameters that make no scene.
+    fn scene(params: &Self::Params) -> Result<crate::scene::Scene, mpm_solver::SolverError>;
 
     /// Runs the case with `params` in `session`, writing its outputs and
     /// `summary.json` (its error against the reference and its results).
@@ -51,6 +60,9 @@ pub struct CaseEntry {
     /// overrides and runs.
     pub run:
         fn(text: &str, origin: &str, set: &[String], session: &Session) -> Result<(), CasesError>,
+    /// The case's scene with the default parameters and the overrides, as
+    /// the text of a scene file.
+    pub scene: fn(set: &[String]) -> Result<String, CasesError>,
 }
 
 impl CaseEntry {
@@ -61,6 +73,7 @@ impl CaseEntry {
             about: C::ABOUT,
             defaults: defaults::<C>,
             run: run::<C>,
+            scene: scene::<C>,
         }
     }
 }
@@ -76,6 +89,14 @@ fn run<C: Case>(
     session: &Session,
 ) -> Result<(), CasesError> {
     C::run(parse_scene(text, origin, set)?, session)
+}
+
+fn scene<C: Case>(set: &[String]) -> Result<String, CasesError> {
+    let params: C::Params = parse_scene("", "command line", set)?;
+    toml::to_string(&C::scene(&params)?).map_err(|source| CasesError::SceneToml {
+        case: C::NAME,
+        source,
+    })
 }
 
 /// Every built-in case, in the order `mpm list` shows them.
@@ -170,36 +191,51 @@ pub(crate) fn simplices_of<const D: usize>(
     }
 }
 
-/// The `[solver]` section of a case's scene: the variant, the number of
-/// equal steps and the Newton tolerance.
-pub(crate) fn solver_section(
-    variant: &crate::variant::Variant,
-    steps: usize,
-    tolerance: f64,
-) -> String {
-    format!(
-        "[solver]\nbasis = \"{}\"\nformulation = \"{}\"\nlocking = \"{}\"\ndomain_update = \"{}\"\ngimp_volume = \"{}\"\nsteps = {steps}\ntolerance = {tolerance:?}\n",
-        variant.basis,
-        variant.formulation,
-        variant.locking,
-        variant.domain_update,
-        variant.gimp_volume
-    )
+/// The number of cells of size `h` along `length` (`what`, e.g. "the
+/// column height"), which `h` must divide.
+///
+/// # Errors
+/// [`mpm_solver::SolverError::InvalidInput`] when it does not (to 1e-9
+/// relative), or gives no cell.
+pub(crate) fn cells_along(
+    h: f64,
+    length: f64,
+    what: &str,
+) -> Result<usize, mpm_solver::SolverError> {
+    let n = (length / h).round();
+    if n.is_nan() || n < 1.0 || (n * h - length).abs() > 1e-9 * length {
+        return Err(mpm_solver::SolverError::InvalidInput(format!(
+            "h = {h} must divide {what} {length}"
+        )));
+    }
+    Ok(n as usize)
 }
 
-/// Builds the scene a case wrote as `text` (named `case` in errors): a
-/// case's parameters that make no valid scene are refused with the
-/// scene's message.
+/// The scene of one body of `material`, named as the material, filling
+/// the box from the origin to `upper` with `points_per_cell` per axis on
+/// the grid `mesh` (the column's and the collapse's).
+pub(crate) fn one_block(
+    mesh: crate::scene::format::MeshSpec,
+    material: crate::scene::format::MaterialSpec,
+    upper: [f64; 2],
+    points_per_cell: usize,
+) -> crate::scene::Scene {
+    let name = material.name.get_ref().clone();
+    let body =
+        crate::scene::format::BodySpec::block(&name, &name, [0.0, 0.0], upper, points_per_cell);
+    crate::scene::Scene::new(mesh, vec![material], vec![body])
+}
+
+/// Builds a case's typed `scene` (named `case` in errors): a case's
+/// parameters that make no valid scene are refused with the scene's
+/// message, which names the case's scene (it has no file, so no line and
+/// column: [`mpm_scene::source::SceneSource::typed`]).
 pub(crate) fn build_scene<const D: usize>(
-    text: &str,
+    scene: &crate::scene::Scene,
     case: &str,
     padding: usize,
 ) -> Result<crate::scene::Problem<D>, mpm_solver::SolverError> {
-    let invalid = |e: mpm_scene::SceneError| {
-        mpm_solver::SolverError::InvalidInput(format!("case {case}: {e}"))
-    };
-    let (scene, src) =
-        crate::scene::parse(text, &format!("the {case} case's scene"), &[]).map_err(invalid)?;
-    crate::scene::Problem::<D>::build_in(&scene, &src, padding, std::path::Path::new(""))
-        .map_err(invalid)
+    let source = mpm_scene::source::SceneSource::typed(&format!("the {case} case's scene"));
+    crate::scene::Problem::<D>::build_in(scene, &source, padding, std::path::Path::new(""))
+        .map_err(|e| mpm_solver::SolverError::InvalidInput(format!("case {case}: {e}")))
 }

@@ -43,8 +43,12 @@ use mpm_constitutive::{
 use mpm_solver::{Flat, SolverError, StepReport};
 use nalgebra::{Matrix2, Matrix3};
 
+use crate::material::MaterialModel;
 use crate::run::{Checkpoint, RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    BodySpec, BoundaryKind, BoundarySpec, MaterialSpec, MeshSpec, NodeSetSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -84,6 +88,10 @@ impl crate::cases::Case for ShearCase {
     const NAME: &'static str = "shear";
     const ABOUT: &'static str = "Coombs 2020 §7.2: simple shear of a unit square, elastic or perfectly plastic (homogeneous)";
     type Params = ShearParams;
+
+    fn scene(p: &ShearParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
 
     fn run(p: ShearParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
         let problem = problem(&p, &p.variant())?;
@@ -183,7 +191,7 @@ pub fn elastic_closed_form(mu: f64, gamma: f64) -> Matrix3<f64> {
     Matrix3::new(s11, s12, 0.0, s12, -s11, 0.0, 0.0, 0.0, 0.0)
 }
 
-/// The shear as a scene (the text of `scenes/coombs2020_shear.toml` with
+/// The shear as a typed scene (the scene of `scenes/coombs2020_shear.toml` with
 /// the parameters and variant filled in): an h-spaced grid shifted left of
 /// the body by `grid_offset`·h, with room for the shear and the padding the
 /// basis needs; the unit square's points on a lattice anchored at its
@@ -193,7 +201,7 @@ pub fn elastic_closed_form(mu: f64, gamma: f64) -> Matrix3<f64> {
 /// # Errors
 /// [`SolverError::InvalidInput`] unless `h` divides 1 and `grid_offset`
 /// lies in [0, 1).
-pub fn scene_text(p: &ShearParams, variant: &Variant) -> Result<String, SolverError> {
+pub fn scene(p: &ShearParams, variant: &Variant) -> Result<Scene, SolverError> {
     let cells = (1.0 / p.h).round();
     if cells < 1.0 || (cells * p.h - 1.0).abs() > 1e-9 {
         return Err(SolverError::InvalidInput(format!(
@@ -214,37 +222,51 @@ pub fn scene_text(p: &ShearParams, variant: &Variant) -> Result<String, SolverEr
     } else {
         0.0
     };
-    let plastic = match p.yield_stress {
-        Some(y) => format!("model = \"von_mises\"\nyield_stress = {y:?}\n"),
-        None => "model = \"hencky\"\n".to_owned(),
+    let model = match p.yield_stress {
+        Some(_) => MaterialModel::VonMises,
+        None => MaterialModel::Hencky,
     };
-    Ok(format!(
-        "[mesh]\norigin = [{ox:?}, 0.0]\nsize = [{sx:?}, {sy:?}]\ncells = [{nx}, {ny}]\n\n\
-         [[material]]\nname = \"square\"\n{plastic}youngs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\n\n\
-         [[body]]\nname = \"square\"\nmaterial = \"square\"\nregion = {{ box = {{ lower = [0.0, 0.0], upper = [1.0, 1.0] }} }}\npoints_per_cell = {ppc}\nlattice_origin = [0.0, 0.0]\n\n\
-         [[node_set]]\nname = \"shell\"\naround = \"square\"\n\n\
-         [[boundary]]\nset = \"shell\"\nkind = \"displacement\"\ngradient = [[0.0, {g:?}], [0.0, 0.0]]\n\n{solver}predictor = {pred}\n",
-        ox = -p.grid_offset * p.h - left,
-        sx = nx as f64 * p.h,
-        sy = ny as f64 * p.h,
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        ppc = p.points_per_cell,
-        g = p.shear,
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
-        pred = p.predictor,
+    let material = MaterialSpec::new("square", model, p.youngs_modulus, p.poisson_ratio, 0.0);
+    let material = match p.yield_stress {
+        Some(y) => material.with_yield_stress(y),
+        None => material,
+    };
+    let body = BodySpec::block(
+        "square",
+        "square",
+        [0.0, 0.0],
+        [1.0, 1.0],
+        p.points_per_cell,
+    )
+    .with_lattice_origin([0.0, 0.0]);
+    Ok(Scene::new(
+        MeshSpec::grid(
+            [-p.grid_offset * p.h - left, 0.0],
+            [nx as f64 * p.h, ny as f64 * p.h],
+            [nx, ny],
+        ),
+        vec![material],
+        vec![body],
+    )
+    .with_node_set(NodeSetSpec::around("shell", "square"))
+    .with_boundary(
+        BoundarySpec::on("shell", BoundaryKind::Displacement)
+            .with_gradient(vec![vec![0.0, p.shear], vec![0.0, 0.0]]),
+    )
+    .with_solver(
+        SolverSpec::implicit(variant, p.load_steps, p.tolerance).with_predictor(p.predictor),
     ))
 }
 
 /// The shear's scene, built.
 ///
 /// # Errors
-/// As [`scene_text`], and the scene's own checks.
+/// As [`scene`], and the scene's own checks.
 pub fn problem(p: &ShearParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(&scene_text(p, variant)?, "shear", variant.basis.padding())
+    super::build_scene(&scene(p, variant)?, "shear", variant.basis.padding())
 }
 
-/// Runs the shear with `variant`: its scene ([`scene_text`]), built and
+/// Runs the shear with `variant`: its scene ([`scene`]), built and
 /// run, every point's stress measured against the single-point reference.
 ///
 /// # Errors

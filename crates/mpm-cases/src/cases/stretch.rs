@@ -29,8 +29,13 @@ use std::path::PathBuf;
 use mpm_solver::{SolverError, StepReport};
 use nalgebra::Matrix3;
 
+use crate::material::MaterialModel;
 use crate::run::{RunControl, RunOutput, Snapshot};
-use crate::scene::Problem;
+use crate::scene::format::{
+    Axes, BodySpec, BoundaryKind, BoundarySpec, MaterialSpec, MeshSpec, MotionSpec, Placement,
+    RegionSpec, SolverSpec,
+};
+use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -84,6 +89,10 @@ impl crate::cases::Case for StretchCase {
     const ABOUT: &'static str =
         "Wang 2021 §5.3: simple stretch of a cube on tetrahedra with a moving mesh (Table 1)";
     type Params = StretchParams;
+
+    fn scene(p: &StretchParams) -> Result<Scene, SolverError> {
+        scene(p, &p.variant())
+    }
 
     fn run(
         mut p: StretchParams,
@@ -148,7 +157,7 @@ pub struct StretchResult {
     pub elements: usize,
 }
 
-/// The stretch as a scene (the text of `scenes/wang2021_stretch.toml`
+/// The stretch as a typed scene (the scene of `scenes/wang2021_stretch.toml`
 /// with the parameters filled in): the cube of `cells` × 2 × `cells`
 /// cells, each split into six ten-node tetrahedra and those into their
 /// eight linear children (or the Gmsh file `mesh`), Keast's 11 points per
@@ -158,63 +167,62 @@ pub struct StretchResult {
 /// # Errors
 /// [`SolverError::InvalidInput`] for a variant other than standard MPM or
 /// F-patch.
-pub fn scene_text(p: &StretchParams, variant: &Variant) -> Result<String, SolverError> {
+pub fn scene(p: &StretchParams, variant: &Variant) -> Result<Scene, SolverError> {
     // The built-in mesh splits ten-node parents (patches); a Gmsh mesh has
     // patches when it is quadratic, which the scene checks.
     variant
         .require_simplex("tetrahedra", true)
         .map_err(SolverError::InvalidInput)?;
+    let a = p.size;
     let mesh = match &p.mesh {
-        Some(path) => format!(
-            "kind = \"gmsh\"\nfile = {}\ndimension = 3\n",
-            toml::Value::String(path.display().to_string())
-        ),
-        None => format!(
-            "kind = \"simplex\"\norigin = [0.0, 0.0, 0.0]\nsize = [{a:?}, {a:?}, {a:?}]\ncells = [{c}, 2, {c}]\npatches = true\n",
-            a = p.size,
-            c = p.cells
-        ),
+        Some(path) => MeshSpec::gmsh(path.display().to_string(), 3),
+        None => MeshSpec::simplex_box([0.0; 3], [a; 3], [p.cells, 2, p.cells]).with_patches(true),
     };
-    let components = if p.clamped_top {
-        "[\"x\", \"y\", \"z\"]"
+    let components: &[&str] = if p.clamped_top {
+        &["x", "y", "z"]
     } else {
-        "[\"y\"]"
+        &["y"]
     };
-    let roller = |set: &str, axis: &str| {
-        format!(
-            "[[boundary]]\nset = \"{set}\"\nkind = \"displacement\"\ndisplacement = {{ {axis} = 0.0 }}\n\n"
-        )
+    let motion = MotionSpec::stretch("y", "y1")
+        .with_stretch(0.0, a, p.stretch)
+        .with_components(components);
+    let material = MaterialSpec::new(
+        "cube",
+        MaterialModel::VonMises,
+        p.youngs_modulus,
+        p.poisson_ratio,
+        0.0,
+    )
+    .with_yield_stress(p.yield_stress)
+    .with_hardening(p.hardening);
+    let body = BodySpec::new("cube", "cube", RegionSpec::box_between([0.0; 3], [a; 3]))
+        .with_placement(Placement::Keast11);
+    let roller = |set: &str, axes: Axes| {
+        BoundarySpec::on(set, BoundaryKind::Displacement).with_displacement(axes)
     };
-    Ok(format!(
-        "[mesh]\n{mesh}\n\
-         [mesh.motion]\nkind = \"stretch\"\naxis = \"y\"\norigin = 0.0\nlength = {a:?}\nextension = {x:?}\ndriven = \"y1\"\ncomponents = {components}\n\n\
-         [[material]]\nname = \"cube\"\nmodel = \"von_mises\"\nyoungs_modulus = {e:?}\npoisson_ratio = {nu:?}\ndensity = 0.0\nyield_stress = {ys:?}\nhardening = {hd:?}\n\n\
-         [[body]]\nname = \"cube\"\nmaterial = \"cube\"\nregion = {{ box = {{ lower = [0.0, 0.0, 0.0], upper = [{a:?}, {a:?}, {a:?}] }} }}\nplacement = \"keast11\"\n\n\
-         {rx}{ry}{rz}{solver}predictor = {pred}\n",
-        a = p.size,
-        x = p.stretch,
-        e = p.youngs_modulus,
-        nu = p.poisson_ratio,
-        ys = p.yield_stress,
-        hd = p.hardening,
-        rx = roller("x0", "x"),
-        ry = roller("y0", "y"),
-        rz = roller("z0", "z"),
-        solver = super::solver_section(variant, p.load_steps, p.tolerance),
-        pred = p.predictor,
-    ))
+    let free = Axes::default();
+    Ok(
+        Scene::new(mesh.with_motion(motion), vec![material], vec![body])
+            .with_boundary(roller("x0", free.with_x(0.0)))
+            .with_boundary(roller("y0", free.with_y(0.0)))
+            .with_boundary(roller("z0", free.with_z(0.0)))
+            .with_solver(
+                SolverSpec::implicit(variant, p.load_steps, p.tolerance)
+                    .with_predictor(p.predictor),
+            ),
+    )
 }
 
 /// The stretch's scene, built.
 ///
 /// # Errors
-/// As [`scene_text`], and the scene's own checks.
+/// As [`scene`], and the scene's own checks.
 pub fn problem(p: &StretchParams, variant: &Variant) -> Result<Problem<3>, SolverError> {
-    super::build_scene(&scene_text(p, variant)?, "stretch", 0)
+    super::build_scene(&scene(p, variant)?, "stretch", 0)
 }
 
 /// Runs the stretch with `variant` (standard MPM or F-patch; UL or PC):
-/// its scene ([`scene_text`]), built and run, measured against the
+/// its scene ([`scene`]), built and run, measured against the
 /// uniaxial stress.
 ///
 /// # Errors
