@@ -7,6 +7,7 @@
 mod curves;
 mod explicit_keys;
 mod materials;
+mod motion;
 mod outputs;
 mod solver;
 
@@ -15,7 +16,7 @@ use std::collections::BTreeMap;
 use mpm_mesh::{RegularGrid, SimplexMesh};
 use mpm_solver::{
     BodyForcePath, Constraints, LoadStepping, MeshMotion, MeshMotionError, MovableMesh, MovingMesh,
-    NewtonOptions, Rotation, StepView, Stretch, Translation,
+    NewtonOptions, StepView,
 };
 use nalgebra::SVector;
 use toml::Spanned;
@@ -26,11 +27,12 @@ use crate::source::SceneSource;
 use crate::variant::{LockingKind, Variant};
 
 use crate::format::{
-    BoundaryKind, Field, LoadKind, MeshKind, MotionKind, Placement, RegionSpec, Scene, TransferKind,
+    BoundaryKind, Field, LoadKind, MeshKind, Placement, RegionSpec, Scene, TransferKind,
 };
 use crate::region::{Region, point};
 
 pub use explicit_keys::{DEFAULT_CFL, DEFAULT_OUTPUTS};
+pub use motion::SceneMotion;
 
 /// Largest number of grid nodes, simplices or material points a scene may
 /// ask for (a guard against a typo allocating the machine's memory).
@@ -1399,7 +1401,14 @@ impl<const D: usize> Problem<D> {
             }
         }
         let motion = match &m.motion {
-            Some(spec) => Some(motion_of(spec, &sets, &initial_nodes, origin, upper, src)?),
+            Some(spec) => Some(motion::motion_of(
+                spec,
+                &sets,
+                &initial_nodes,
+                origin,
+                upper,
+                src,
+            )?),
             None => None,
         };
         let constraints = SceneConstraints {
@@ -2174,212 +2183,6 @@ fn gradient_of<const D: usize>(
         return Err(src.at(g, "`gradient` must be finite"));
     }
     Ok(nalgebra::SMatrix::<f64, D, D>::from_fn(|i, j| rows[i][j]))
-}
-
-/// The mesh motions a scene can give (`[mesh.motion] kind`): one type, so
-/// that the solvers are compiled once whatever the motion (it is evaluated
-/// once per node and step).
-#[derive(Debug, Clone, PartialEq)]
-pub enum SceneMotion<const D: usize> {
-    /// `stretch`.
-    Stretch(Stretch),
-    /// `rotation`.
-    Rotation(Rotation<D>),
-    /// `translation`.
-    Translation(Translation<D>),
-}
-
-impl<const D: usize> MeshMotion<D> for SceneMotion<D> {
-    #[inline]
-    fn position(&self, node: usize, x0: &SVector<f64, D>, lambda: f64) -> SVector<f64, D> {
-        match self {
-            SceneMotion::Stretch(m) => MeshMotion::<D>::position(m, node, x0, lambda),
-            SceneMotion::Rotation(m) => m.position(node, x0, lambda),
-            SceneMotion::Translation(m) => m.position(node, x0, lambda),
-        }
-    }
-}
-
-/// The mesh motion of `[mesh.motion]`.
-fn motion_of<const D: usize>(
-    spec: &crate::format::MotionSpec,
-    sets: &BTreeMap<String, Vec<usize>>,
-    initial: &[SVector<f64, D>],
-    lower: SVector<f64, D>,
-    upper: SVector<f64, D>,
-    src: &SceneSource,
-) -> Result<MovingMesh<D, Free, SceneMotion<D>>, SceneError> {
-    let axis_of = |name: &str| AXES.iter().take(D).position(|a| *a == name);
-    let axis =
-        match &spec.axis {
-            Some(a) => Some(axis_of(a.get_ref()).ok_or_else(|| {
-                src.at(a, format!("`axis` must be one of {}", AXES[..D].join(", ")))
-            })?),
-            None => None,
-        };
-    let refuse = |present: bool, key: &str, kind: &str| -> Result<(), SceneError> {
-        if present {
-            Err(src.at(
-                &spec.kind,
-                format!("`{key}` does not apply to a {kind} motion"),
-            ))
-        } else {
-            Ok(())
-        }
-    };
-    let named = |name: &Spanned<String>| lookup_ref(sets, name, "node set", src);
-    if !matches!(spec.kind.get_ref(), MotionKind::Translation) {
-        refuse(
-            spec.displacement.is_some(),
-            "displacement",
-            "stretch or rotation",
-        )?;
-        refuse(spec.carried.is_some(), "carried", "stretch or rotation")?;
-        refuse(spec.fixed.is_some(), "fixed", "stretch or rotation")?;
-    }
-    let (motion, default_components) = match spec.kind.get_ref() {
-        MotionKind::Translation => {
-            for (present, key) in [
-                (spec.axis.is_some(), "axis"),
-                (spec.extension.is_some(), "extension"),
-                (spec.length.is_some(), "length"),
-                (spec.origin.is_some(), "origin"),
-                (spec.centre.is_some(), "centre"),
-                (spec.angle.is_some(), "angle"),
-            ] {
-                refuse(present, key, "translation")?;
-            }
-            let Some(d) = &spec.displacement else {
-                return Err(src.at(
-                    &spec.kind,
-                    "a translation needs `displacement` (m, one number per axis, at load factor 1)",
-                ));
-            };
-            let displacement = point::<D>(d, "translation `displacement`", src)?;
-            if !displacement.iter().all(|v| v.is_finite()) {
-                return Err(src.at(d, "translation `displacement` must be finite"));
-            }
-            let Some(fixed_name) = &spec.fixed else {
-                return Err(src.at(
-                    &spec.kind,
-                    "a translation needs `fixed`: the node set that stays (the mesh between it and the carried set is compressed or stretched)",
-                ));
-            };
-            let carried_name = spec.carried.as_ref().unwrap_or(&spec.driven);
-            let (carried, fixed) = (named(carried_name)?, named(fixed_name)?);
-            let translation = Translation::new(initial, carried, fixed, displacement)
-                .ok_or_else(|| {
-                    src.at(
-                        fixed_name,
-                        format!(
-                            "a translation needs non-empty carried (`{}`, {} nodes) and fixed (`{}`, {} nodes) sets with no node in both",
-                            carried_name.get_ref(),
-                            carried.len(),
-                            fixed_name.get_ref(),
-                            fixed.len()
-                        ),
-                    )
-                })?;
-            (SceneMotion::Translation(translation), [true; D])
-        }
-        MotionKind::Stretch => {
-            refuse(spec.centre.is_some(), "centre", "stretch")?;
-            refuse(spec.angle.is_some(), "angle", "stretch")?;
-            let Some(axis) = axis else {
-                return Err(src.at(&spec.kind, "a stretch needs `axis`"));
-            };
-            let Some(extension_at) = &spec.extension else {
-                return Err(src.at(&spec.kind, "a stretch needs `extension` (m)"));
-            };
-            let extension = *extension_at.get_ref();
-            let origin = spec.origin.unwrap_or(lower[axis]);
-            let length = match &spec.length {
-                Some(l) => *l.get_ref(),
-                None => upper[axis] - origin,
-            };
-            if !(length > 0.0 && length.is_finite() && origin.is_finite()) {
-                let at = spec.length.as_ref().map_or(spec.kind.span(), Spanned::span);
-                return Err(src.error(
-                    Some(at),
-                    &format!(
-                        "a stretch needs a finite positive length from `origin`, got {length}"
-                    ),
-                ));
-            }
-            if !extension.is_finite() || length + extension <= 0.0 {
-                return Err(src.at(
-                    extension_at,
-                    format!("`extension` {extension} must be finite and leave a positive length"),
-                ));
-            }
-            let mut components = [false; D];
-            components[axis] = true;
-            (
-                SceneMotion::Stretch(Stretch {
-                    axis,
-                    origin,
-                    length,
-                    extension,
-                }),
-                components,
-            )
-        }
-        MotionKind::Rotation => {
-            refuse(spec.extension.is_some(), "extension", "rotation")?;
-            refuse(spec.length.is_some(), "length", "rotation")?;
-            refuse(spec.origin.is_some(), "origin", "rotation")?;
-            if D == 3 && axis.is_none() {
-                return Err(src.at(&spec.kind, "a rotation in 3D needs `axis` (x, y or z)"));
-            }
-            if let (2, Some(a)) = (D, &spec.axis) {
-                return Err(src.at(
-                    a,
-                    "a rotation in 2D is about the out-of-plane axis: leave out `axis`",
-                ));
-            }
-            let centre = match &spec.centre {
-                None => SVector::<f64, D>::zeros(),
-                Some(c) => point::<D>(c, "rotation `centre`", src)?,
-            };
-            let Some(angle) = &spec.angle else {
-                return Err(src.at(
-                    &spec.kind,
-                    "a rotation needs `angle` (radians at load factor 1)",
-                ));
-            };
-            if !angle.get_ref().is_finite() {
-                return Err(src.at(angle, "`angle` must be finite"));
-            }
-            let rotation =
-                Rotation::about_coordinate_axis(centre, axis.unwrap_or(2), *angle.get_ref())
-                    .ok_or_else(|| src.at(&spec.kind, "a rotation needs 2 or 3 dimensions"))?;
-            (SceneMotion::Rotation(rotation), [true; D])
-        }
-    };
-    let driven = named(&spec.driven)?;
-    let components = match &spec.components {
-        None => default_components,
-        Some(list) => {
-            let mut components = [false; D];
-            for name in list.get_ref() {
-                let Some(i) = axis_of(name) else {
-                    return Err(src.at(
-                        list,
-                        format!("`components` must name axes among {}", AXES[..D].join(", ")),
-                    ));
-                };
-                components[i] = true;
-            }
-            components
-        }
-    };
-    Ok(MovingMesh::new(
-        Free,
-        motion,
-        initial.to_vec(),
-        driven,
-        components,
-    ))
 }
 
 /// Point arrays while the bodies are filled.
