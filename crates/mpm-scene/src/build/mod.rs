@@ -4,6 +4,7 @@
 //! sections happens here, before anything is run or written, and each
 //! error names the place in the file (or the override) it comes from.
 
+mod bodies;
 mod curves;
 mod explicit_keys;
 mod materials;
@@ -27,7 +28,7 @@ use crate::material::{MaterialModel, MaterialParams};
 use crate::source::SceneSource;
 use crate::variant::{LockingKind, Variant};
 
-use crate::format::{BoundaryKind, Field, LoadKind, Placement, RegionSpec, Scene, TransferKind};
+use crate::format::{BoundaryKind, Field, LoadKind, Scene, TransferKind};
 use crate::region::{Region, point};
 
 pub use explicit_keys::{DEFAULT_CFL, DEFAULT_OUTPUTS};
@@ -549,7 +550,6 @@ impl<const D: usize> Problem<D> {
         basis_padding: usize,
         mesh_dir: &std::path::Path,
     ) -> Result<Self, SceneError> {
-        let check = Check { src };
         let solver = &scene.solver;
         let explicit_keys = explicit_keys::solver_keys(solver, src)?;
         let explicit = explicit_keys.is_some();
@@ -572,14 +572,6 @@ impl<const D: usize> Problem<D> {
         // Mesh.
         let built_mesh = mesh::mesh::<D>(scene, &variant, explicit, basis_padding, mesh_dir, src)?;
         let tol = built_mesh.tol();
-        let mesh::BuiltMesh {
-            mesh,
-            origin,
-            upper,
-            padding,
-            patch_of_element,
-            warnings,
-        } = built_mesh;
 
         // Curves (index 0: the default ramp).
         let (curve_names, curves) = curves::curves(&scene.curves, src)?;
@@ -594,230 +586,29 @@ impl<const D: usize> Problem<D> {
         let (material_names, materials) = materials::materials(&scene.materials, explicit, src)?;
 
         // Bodies.
-        if scene.bodies.is_empty() {
-            return Err(src.error(None, "a scene needs at least one [[body]]"));
-        }
-        unique_names(scene.bodies.iter().map(|b| &b.name), "body", src)?;
-        let mut regions: Vec<Option<Region<D>>> = Vec::new();
-        let mut problem_points = Points::<D>::default();
-        let mut initial_velocity: Vec<SVector<f64, D>> = Vec::new();
-        let mut bodies = Vec::new();
-        let mut element_owner: Vec<Option<usize>> = match &mesh {
-            SceneMesh::Simplex(sm) => vec![None; sm.element_count()],
-            SceneMesh::Grid(_) => Vec::new(),
-        };
-        for (b, spec) in scene.bodies.iter().enumerate() {
-            let material = lookup(&material_names, &spec.material, "material", src)?;
-            let region = match (&spec.region, &mesh) {
-                (RegionSpec::Group(_), SceneMesh::Simplex(_)) => None,
-                (other, _) => Some(Region::<D>::new(other, src)?),
-            };
-            if let Some(region) = &region {
-                let (lo, hi) = region.bounds();
-                if (0..D).any(|i| lo[i] < origin[i] - tol || hi[i] > upper[i] + tol) {
-                    return Err(src.at(
-                        &spec.name,
-                        format!(
-                            "body `{}` reaches outside the mesh: its region spans {:?} to {:?}, the mesh {:?} to {:?}",
-                            spec.name.get_ref(),
-                            lo.as_slice(),
-                            hi.as_slice(),
-                            origin.as_slice(),
-                            upper.as_slice()
-                        ),
-                    ));
-                }
-            }
-            let ppc = check.at_least(&spec.points_per_cell, 1, "points_per_cell")?;
-            let start = problem_points.position.len();
-            let step = match &mesh {
-                SceneMesh::Grid(grid) => {
-                    let cells: [usize; D] =
-                        std::array::from_fn(|i| grid.cells_per_axis()[i] - 2 * padding);
-                    let Some(region) = &region else {
-                        return Err(src.error(None, "internal: a grid body without a region"));
-                    };
-                    if let Some(p) = spec.placement.as_ref()
-                        && *p.get_ref() != Placement::Regular
-                    {
-                        let name = if *p.get_ref() == Placement::Gauss4 {
-                            "gauss4"
-                        } else {
-                            "keast11"
-                        };
-                        return Err(src.at(
-                            p,
-                            format!("placement = {name} places points in tetrahedra; a body on a grid has placement = regular"),
-                        ));
-                    }
-                    let anchor = match &spec.lattice_origin {
-                        Some(a) => Some(point::<D>(a, "`lattice_origin`", src)?),
-                        None => None,
-                    };
-                    problem_points
-                        .fill(
-                            grid,
-                            padding,
-                            cells,
-                            region,
-                            ppc,
-                            anchor,
-                            src,
-                            &spec.points_per_cell,
-                        )?
-                        .as_slice()
-                        .to_vec()
-                }
-                SceneMesh::Simplex(sm) => {
-                    let elements: Vec<usize> = match (&spec.region, &region) {
-                        (RegionSpec::Group(name), _) => sm
-                            .element_sets()
-                            .get(name.get_ref())
-                            .ok_or_else(|| {
-                                src.at(
-                                    name,
-                                    format!(
-                                        "the mesh has no physical group `{}` of elements; it has: {}",
-                                        name.get_ref(),
-                                        sm.element_sets().names().collect::<Vec<_>>().join(", ")
-                                    ),
-                                )
-                            })?
-                            .to_vec(),
-                        (_, Some(region)) => (0..sm.element_count())
-                            .filter(|&e| {
-                                let nodes = sm.element_nodes(e);
-                                let c = nodes.iter().fold(SVector::<f64, D>::zeros(), |c, &v| c + sm.nodes()[v])
-                                    / nodes.len() as f64;
-                                region.contains(&c)
-                            })
-                            .collect(),
-                        (_, None) => Vec::new(),
-                    };
-                    if let Some(a) = &spec.lattice_origin {
-                        return Err(src.at(
-                            a,
-                            "`lattice_origin` applies to bodies on a grid (simplex bodies fill their elements)",
-                        ));
-                    }
-                    let rule = match spec.placement.as_ref() {
-                        Some(p) if *p.get_ref() != Placement::Regular => {
-                            let (rule, name) = match p.get_ref() {
-                                Placement::Gauss4 => (crate::body::SimplexRule::Gauss4, "gauss4"),
-                                _ => (crate::body::SimplexRule::Keast11, "keast11"),
-                            };
-                            if D != 3 {
-                                return Err(src.at(
-                                    p,
-                                    format!(
-                                        "placement = {name} is a rule for tetrahedra (3D meshes)"
-                                    ),
-                                ));
-                            }
-                            rule
-                        }
-                        _ => crate::body::SimplexRule::Subdivision(ppc),
-                    };
-                    let per_element = match rule {
-                        crate::body::SimplexRule::Keast11 => 11,
-                        crate::body::SimplexRule::Gauss4 => 4,
-                        crate::body::SimplexRule::Subdivision(_) => {
-                            ppc.checked_pow(D as u32).unwrap_or(usize::MAX)
-                        }
-                    };
-                    if elements
-                        .len()
-                        .saturating_mul(per_element)
-                        .saturating_add(start)
-                        > MAX_ENTITIES
-                    {
-                        return Err(src.at(
-                            &spec.points_per_cell,
-                            format!(
-                                "the scene would hold more than {MAX_ENTITIES} material points"
-                            ),
-                        ));
-                    }
-                    for &e in &elements {
-                        if let Some(other) = element_owner[e] {
-                            return Err(src.at(
-                                &spec.name,
-                                format!(
-                                    "body `{}` overlaps body `{}` (both hold element {e}); bodies may touch but not overlap",
-                                    spec.name.get_ref(),
-                                    scene.bodies[other].name.get_ref()
-                                ),
-                            ));
-                        }
-                        element_owner[e] = Some(b);
-                    }
-                    let body = crate::body::Body::fill_simplices(sm, &elements, rule);
-                    problem_points.position.extend_from_slice(&body.position);
-                    problem_points.volume.extend_from_slice(&body.volume);
-                    problem_points
-                        .half_lengths
-                        .extend_from_slice(&body.half_lengths);
-                    Vec::new()
-                }
-            };
-            let end = problem_points.position.len();
-            if end == start {
-                return Err(src.at(
-                    &spec.name,
-                    format!(
-                        "body `{}` holds no material points: no sub-cell centre at {ppc} points per cell lies in its region",
-                        spec.name.get_ref()
-                    ),
-                ));
-            }
-            if matches!(mesh, SceneMesh::Grid(_)) {
-                for p in start..end {
-                    if let Some(other) = regions.iter().position(|r| {
-                        r.as_ref()
-                            .is_some_and(|r| r.contains(&problem_points.position[p]))
-                    }) {
-                        return Err(src.at(
-                            &spec.name,
-                            format!(
-                                "body `{}` overlaps body `{}` (both hold {:?}); bodies may touch but not overlap",
-                                spec.name.get_ref(),
-                                scene.bodies[other].name.get_ref(),
-                                problem_points.position[p].as_slice()
-                            ),
-                        ));
-                    }
-                }
-            }
-            let density = materials[material].density;
-            for p in start..end {
-                problem_points.mass.push(problem_points.volume[p] * density);
-                problem_points.material.push(material as u32);
-                problem_points.body.push(b as u32);
-            }
-            let v0 = match &spec.velocity {
-                Some(v) if !explicit => {
-                    return Err(src.at(
-                        v,
-                        "a body's `velocity` (its initial velocity) applies to the explicit solver ([solver] kind = \"explicit\"); the implicit solver is quasi-static",
-                    ));
-                }
-                Some(v) => point::<D>(v, "body `velocity`", src)?,
-                None => SVector::zeros(),
-            };
-            initial_velocity.resize(end, v0);
-            regions.push(region);
-            bodies.push(BuiltBody {
-                name: spec.name.get_ref().clone(),
-                material,
-                points: start..end,
-                step,
-            });
-        }
-        let body_names: BTreeMap<String, usize> = bodies
-            .iter()
-            .enumerate()
-            .map(|(k, b)| (b.name.clone(), k))
-            .collect();
+        let built_bodies = bodies::bodies(
+            &scene.bodies,
+            &built_mesh,
+            &material_names,
+            &materials,
+            explicit,
+            src,
+        )?;
+        let mesh::BuiltMesh {
+            mesh,
+            origin,
+            upper,
+            padding,
+            patch_of_element,
+            warnings,
+        } = built_mesh;
+        let bodies::BuiltBodies {
+            bodies,
+            regions,
+            points: problem_points,
+            velocity: mut initial_velocity,
+            names: body_names,
+        } = built_bodies;
         let n = problem_points.position.len();
 
         // Node sets: the faces, then the named ones.
@@ -1159,17 +950,7 @@ impl<const D: usize> Problem<D> {
         let mut point_forces = Vec::new();
         let mut curved: BTreeMap<usize, Vec<SVector<f64, D>>> = BTreeMap::new();
         let mut manufactured = Vec::new();
-        let nearest = |x: &SVector<f64, D>| -> usize {
-            (0..n)
-                .min_by(|&a, &b| {
-                    let (da, db) = (
-                        (problem_points.position[a] - x).norm_squared(),
-                        (problem_points.position[b] - x).norm_squared(),
-                    );
-                    da.total_cmp(&db)
-                })
-                .unwrap_or(0)
-        };
+        let nearest = |x: &SVector<f64, D>| problem_points.nearest(x);
         let mut explicit_gravity = SVector::<f64, D>::zeros();
         let mut explicit_forces: Vec<(usize, SVector<f64, D>)> = Vec::new();
         let mut timed_forces: Vec<TimedForces<D>> = Vec::new();
@@ -1736,82 +1517,6 @@ fn gradient_of<const D: usize>(
         return Err(src.at(g, "`gradient` must be finite"));
     }
     Ok(nalgebra::SMatrix::<f64, D, D>::from_fn(|i, j| rows[i][j]))
-}
-
-/// Point arrays while the bodies are filled.
-#[derive(Default)]
-struct Points<const D: usize> {
-    position: Vec<SVector<f64, D>>,
-    volume: Vec<f64>,
-    half_lengths: Vec<SVector<f64, D>>,
-    mass: Vec<f64>,
-    material: Vec<u32>,
-    body: Vec<u32>,
-}
-
-impl<const D: usize> Points<D> {
-    /// Adds the sub-cell centres (`ppc` per axis per cell of the unpadded
-    /// grid) that lie in `region`; returns the lattice step.
-    #[allow(clippy::too_many_arguments)]
-    fn fill(
-        &mut self,
-        grid: &RegularGrid<D>,
-        padding: usize,
-        cells: [usize; D],
-        region: &Region<D>,
-        ppc: usize,
-        anchor: Option<SVector<f64, D>>,
-        src: &SceneSource,
-        ppc_span: &Spanned<usize>,
-    ) -> Result<SVector<f64, D>, SceneError> {
-        let h = *grid.spacing();
-        let step = h / ppc as f64;
-        // The lattice: sub-cells of the unpadded grid, or anchored at the
-        // body's own `lattice_origin` (then the region, which lies in the
-        // mesh, bounds it).
-        let origin = anchor.unwrap_or_else(|| grid.origin() + h * padding as f64);
-        // Only the lattice over the region's bounding box is visited.
-        let (lo, hi) = region.bounds();
-        let mut first = [0i64; D];
-        let mut count = [0usize; D];
-        for i in 0..D {
-            let a = ((lo[i] - origin[i]) / step[i]).floor();
-            let b = ((hi[i] - origin[i]) / step[i]).ceil();
-            if anchor.is_some() {
-                first[i] = a as i64;
-                count[i] = (b - a).max(0.0) as usize;
-            } else {
-                let per_axis = cells[i].saturating_mul(ppc);
-                let a = (a.max(0.0) as usize).min(per_axis);
-                let b = (b.max(0.0) as usize).min(per_axis);
-                first[i] = a as i64;
-                count[i] = b.saturating_sub(a);
-            }
-        }
-        let total = count.iter().try_fold(1usize, |n, &c| n.checked_mul(c));
-        if total.is_none_or(|t| t.saturating_add(self.position.len()) > MAX_ENTITIES) {
-            return Err(src.at(
-                ppc_span,
-                format!("the scene would hold more than {MAX_ENTITIES} material points"),
-            ));
-        }
-        let volume = step.iter().product::<f64>();
-        for flat in 0..total.unwrap_or(0) {
-            let mut rest = flat;
-            let mut x = SVector::<f64, D>::zeros();
-            for i in 0..D {
-                let k = first[i] + (rest % count[i]) as i64;
-                rest /= count[i];
-                x[i] = origin[i] + (k as f64 + 0.5) * step[i];
-            }
-            if region.contains(&x) {
-                self.position.push(x);
-                self.volume.push(volume);
-                self.half_lengths.push(step / 2.0);
-            }
-        }
-        Ok(step)
-    }
 }
 
 #[cfg(test)]
