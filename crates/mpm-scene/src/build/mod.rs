@@ -10,6 +10,7 @@ mod explicit_keys;
 mod materials;
 mod mesh;
 mod motion;
+mod node_sets;
 mod outputs;
 mod solver;
 
@@ -571,7 +572,6 @@ impl<const D: usize> Problem<D> {
 
         // Mesh.
         let built_mesh = mesh::mesh::<D>(scene, &variant, explicit, basis_padding, mesh_dir, src)?;
-        let tol = built_mesh.tol();
 
         // Curves (index 0: the default ramp).
         let (curve_names, curves) = curves::curves(&scene.curves, src)?;
@@ -594,6 +594,9 @@ impl<const D: usize> Problem<D> {
             explicit,
             src,
         )?;
+
+        // Node sets: the faces, then the named ones.
+        let node_sets = node_sets::node_sets(&scene.node_sets, &built_mesh, &built_bodies, src)?;
         let mesh::BuiltMesh {
             mesh,
             origin,
@@ -611,111 +614,11 @@ impl<const D: usize> Problem<D> {
         } = built_bodies;
         let n = problem_points.position.len();
 
-        // Node sets: the faces, then the named ones.
-        let mut sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+        let sets = &node_sets.sets;
+        let following_sets = &node_sets.following;
+        let faces = &node_sets.faces;
         let node_position = |v: usize| mesh.node_position(v);
-        for axis in 0..D {
-            for upper_face in [false, true] {
-                let bound = if upper_face {
-                    upper[axis]
-                } else {
-                    origin[axis]
-                };
-                let nodes = (0..mesh.node_count())
-                    .filter(|&v| {
-                        let x = node_position(v)[axis];
-                        if upper_face {
-                            x >= bound - tol
-                        } else {
-                            x <= bound + tol
-                        }
-                    })
-                    .collect();
-                sets.insert(face_name(axis, upper_face), nodes);
-            }
-        }
-        let faces: Vec<String> = sets.keys().cloned().collect();
-        if let SceneMesh::Simplex(sm) = &mesh {
-            // The mesh's physical groups, unless a face has their name.
-            for (name, nodes) in sm.node_sets().iter() {
-                sets.entry(name.to_owned())
-                    .or_insert_with(|| nodes.to_vec());
-            }
-        }
-        // Sets that follow a body: its boundary points.
-        let mut following_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
-        for spec in &scene.node_sets {
-            if sets.contains_key(spec.name.get_ref())
-                || following_sets.contains_key(spec.name.get_ref())
-            {
-                return Err(src.at(
-                    &spec.name,
-                    format!(
-                        "node set `{}` is already defined (a grid face or an earlier set)",
-                        spec.name.get_ref()
-                    ),
-                ));
-            }
-            let region_spec = match (&spec.region, &spec.around) {
-                (Some(r), None) => r,
-                (None, Some(body_name)) => {
-                    let k = lookup(&body_names, body_name, "body", src)?;
-                    let body = &bodies[k];
-                    let (Some(region), false) = (&regions[k], body.step.is_empty()) else {
-                        return Err(src.at(
-                            body_name,
-                            "`around` needs a body given by a region on a grid (its boundary points are those with a lattice neighbour outside the region)",
-                        ));
-                    };
-                    let boundary: Vec<usize> = body
-                        .points
-                        .clone()
-                        .filter(|&p| {
-                            let x = problem_points.position[p];
-                            (0..D).any(|i| {
-                                let mut e = SVector::<f64, D>::zeros();
-                                e[i] = body.step[i];
-                                !region.contains(&(x + e)) || !region.contains(&(x - e))
-                            })
-                        })
-                        .collect();
-                    following_sets.insert(spec.name.get_ref().clone(), boundary);
-                    continue;
-                }
-                _ => {
-                    return Err(src.at(
-                        &spec.name,
-                        format!(
-                            "node set `{}` needs one of `region` or `around`",
-                            spec.name.get_ref()
-                        ),
-                    ));
-                }
-            };
-            let region = Region::<D>::new(region_spec, src)?;
-            let nodes: Vec<usize> = (0..mesh.node_count())
-                .filter(|&v| region.contains(&node_position(v)))
-                .collect();
-            if nodes.is_empty() {
-                return Err(src.at(
-                    &spec.name,
-                    format!("node set `{}` holds no grid node", spec.name.get_ref()),
-                ));
-            }
-            sets.insert(spec.name.get_ref().clone(), nodes);
-        }
-        let set_of = |name: &Spanned<String>| -> Result<&Vec<usize>, SceneError> {
-            if following_sets.contains_key(name.get_ref()) {
-                return Err(src.at(
-                    name,
-                    format!(
-                        "node set `{}` follows a body (its nodes change every step); use it for a fixed or displacement boundary",
-                        name.get_ref()
-                    ),
-                ));
-            }
-            lookup_ref(&sets, name, "node set", src)
-        };
+        let set_of = |name: &Spanned<String>| node_sets.set_of(name, src);
 
         // Boundaries (later conditions replace earlier ones on shared dofs).
         let mut dofs: Vec<Option<(f64, u16)>> = vec![None; mesh.node_count() * D];
@@ -930,7 +833,7 @@ impl<const D: usize> Problem<D> {
         let motion = match &scene.mesh.motion {
             Some(spec) => Some(motion::motion_of(
                 spec,
-                &sets,
+                sets,
                 &initial_nodes,
                 origin,
                 upper,
