@@ -5,6 +5,7 @@
 //! error names the place in the file (or the override) it comes from.
 
 mod bodies;
+mod conditions;
 mod curves;
 mod explicit_keys;
 mod materials;
@@ -29,7 +30,7 @@ use crate::material::{MaterialModel, MaterialParams};
 use crate::source::SceneSource;
 use crate::variant::{LockingKind, Variant};
 
-use crate::format::{BoundaryKind, Field, LoadKind, Scene, TransferKind};
+use crate::format::{Axes, Field, LoadKind, Scene, TransferKind};
 use crate::region::{Region, point};
 
 pub use explicit_keys::{DEFAULT_CFL, DEFAULT_OUTPUTS};
@@ -519,6 +520,26 @@ fn lookup_ref<'m, V>(
     })
 }
 
+/// The components of a per-axis table named `key`, checked against the
+/// dimension (at least one given, all finite).
+fn axes_of<const D: usize>(
+    d: &Spanned<Axes>,
+    key: &str,
+    src: &SceneSource,
+) -> Result<[Option<f64>; 3], SceneError> {
+    let values = d.get_ref().get();
+    if let Some(axis) = (D..3).find(|&i| values[i].is_some()) {
+        return Err(src.at(d, format!("a {D}D scene has no {} component", AXES[axis])));
+    }
+    if values.iter().all(Option::is_none) {
+        return Err(src.at(d, format!("`{key}` needs at least one of x, y, z")));
+    }
+    if let Some(v) = values.iter().flatten().find(|v| !v.is_finite()) {
+        return Err(src.at(d, format!("`{key}` must be finite, got {v}")));
+    }
+    Ok(values)
+}
+
 impl<const D: usize> Problem<D> {
     /// Builds the scene with at least `basis_padding` cells of padding
     /// (and at least what the scene's basis needs,
@@ -574,13 +595,9 @@ impl<const D: usize> Problem<D> {
         let built_mesh = mesh::mesh::<D>(scene, &variant, explicit, basis_padding, mesh_dir, src)?;
 
         // Curves (index 0: the default ramp).
-        let (curve_names, curves) = curves::curves(&scene.curves, src)?;
-        let curve_of = |name: &Option<Spanned<String>>| -> Result<usize, SceneError> {
-            match name {
-                None => Ok(0),
-                Some(n) => lookup(&curve_names, n, "curve", src).map(|k| k + 1),
-            }
-        };
+        let curve_table = curves::curves(&scene.curves, src)?;
+        let curves = &curve_table.curves;
+        let curve_of = |name: &Option<Spanned<String>>| curve_table.index(name, src);
 
         // Materials.
         let (material_names, materials) = materials::materials(&scene.materials, explicit, src)?;
@@ -597,13 +614,19 @@ impl<const D: usize> Problem<D> {
 
         // Node sets: the faces, then the named ones.
         let node_sets = node_sets::node_sets(&scene.node_sets, &built_mesh, &built_bodies, src)?;
+
+        // Conditions: boundaries, then the mesh motion.
+        let conditions =
+            conditions::conditions(scene, &built_mesh, &node_sets, &curve_table, explicit, src)?;
+        let constraints = conditions.constraints;
+        let velocity_dofs = conditions.velocity_dofs;
+
         let mesh::BuiltMesh {
             mesh,
-            origin,
-            upper,
             padding,
             patch_of_element,
             warnings,
+            ..
         } = built_mesh;
         let bodies::BuiltBodies {
             bodies,
@@ -614,239 +637,8 @@ impl<const D: usize> Problem<D> {
         } = built_bodies;
         let n = problem_points.position.len();
 
-        let sets = &node_sets.sets;
-        let following_sets = &node_sets.following;
         let faces = &node_sets.faces;
-        let node_position = |v: usize| mesh.node_position(v);
         let set_of = |name: &Spanned<String>| node_sets.set_of(name, src);
-
-        // Boundaries (later conditions replace earlier ones on shared dofs).
-        let mut dofs: Vec<Option<(f64, u16)>> = vec![None; mesh.node_count() * D];
-        let mut following = Vec::new();
-        let initial_nodes: Vec<SVector<f64, D>> =
-            (0..mesh.node_count()).map(node_position).collect();
-        let mut velocity_dofs: Vec<Option<f64>> = vec![None; mesh.node_count() * D];
-        for spec in &scene.boundaries {
-            let gradient = match &spec.gradient {
-                Some(g) => Some(gradient_of::<D>(g, src)?),
-                None => None,
-            };
-            let kind = *spec.kind.get_ref();
-            if spec.velocity.is_some() && kind != BoundaryKind::Velocity {
-                return Err(src.at(
-                    &spec.kind,
-                    format!(
-                        "`velocity` applies to kind = velocity, not {}",
-                        boundary_kind_name(kind)
-                    ),
-                ));
-            }
-            if explicit && following_sets.contains_key(spec.set.get_ref()) {
-                return Err(src.at(
-                    &spec.set,
-                    format!(
-                        "node set `{}` follows a body; the explicit solver's conditions hold fixed sets of nodes",
-                        spec.set.get_ref()
-                    ),
-                ));
-            }
-            if let Some(points) = following_sets.get(spec.set.get_ref()) {
-                let (displacement, gradient, curve) = match spec.kind.get_ref() {
-                    BoundaryKind::Fixed => {
-                        if spec.displacement.is_some()
-                            || spec.gradient.is_some()
-                            || spec.curve.is_some()
-                        {
-                            return Err(src.at(&spec.kind, "`displacement`, `gradient` and `curve` apply to kind = displacement, not fixed"));
-                        }
-                        (SVector::zeros(), nalgebra::SMatrix::<f64, D, D>::zeros(), 0)
-                    }
-                    BoundaryKind::Displacement => {
-                        let d = match &spec.displacement {
-                            Some(d) => displacement_of::<D>(d, src)?,
-                            None if gradient.is_some() => [None; 3],
-                            None => {
-                                return Err(src.at(&spec.kind, "kind = displacement needs `displacement = { x = …, y = … }` or `gradient`"));
-                            }
-                        };
-                        if gradient.is_none() && d.iter().take(D).any(Option::is_none) {
-                            return Err(src.at(&spec.set, "a displacement on a set that follows a body prescribes every component: give all of them, or a `gradient`"));
-                        }
-                        (
-                            SVector::<f64, D>::from_fn(|i, _| d[i].unwrap_or(0.0)),
-                            gradient.unwrap_or_else(nalgebra::SMatrix::<f64, D, D>::zeros),
-                            curve_of(&spec.curve)?,
-                        )
-                    }
-                    BoundaryKind::Roller => {
-                        return Err(src.at(
-                            &spec.set,
-                            format!(
-                                "a roller needs a grid face for its normal; `{}` follows a body",
-                                spec.set.get_ref()
-                            ),
-                        ));
-                    }
-                    BoundaryKind::Velocity => {
-                        return Err(src.at(
-                            &spec.kind,
-                            "kind = velocity needs the explicit solver; the implicit solver prescribes displacements (kind = displacement)",
-                        ));
-                    }
-                };
-                following.push(Following {
-                    points: points.clone(),
-                    nodes: initial_nodes.clone(),
-                    active: vec![false; mesh.node_count()],
-                    displacement,
-                    gradient,
-                    curve: curve as u16,
-                });
-                continue;
-            }
-            let nodes = set_of(&spec.set)?;
-            let mut prescribe = |component: usize, value: f64, curve: usize| {
-                for &v in nodes {
-                    dofs[v * D + component] = Some((value, curve as u16));
-                    // Explicit runs: a held node (explicit displacements are zero).
-                    velocity_dofs[v * D + component] = Some(0.0);
-                }
-            };
-            let not_here = |what: &str, kind: &str| {
-                src.at(
-                    &spec.kind,
-                    format!("`{what}` applies to kind = displacement, not {kind}"),
-                )
-            };
-            match spec.kind.get_ref() {
-                BoundaryKind::Fixed | BoundaryKind::Roller => {
-                    let kind = if *spec.kind.get_ref() == BoundaryKind::Fixed {
-                        "fixed"
-                    } else {
-                        "roller"
-                    };
-                    if spec.displacement.is_some() {
-                        return Err(not_here("displacement", kind));
-                    }
-                    if spec.curve.is_some() {
-                        return Err(not_here("curve", kind));
-                    }
-                    if spec.gradient.is_some() {
-                        return Err(not_here("gradient", kind));
-                    }
-                    if *spec.kind.get_ref() == BoundaryKind::Fixed {
-                        (0..D).for_each(|i| prescribe(i, 0.0, 0));
-                    } else {
-                        let axis = (0..D).find(|&i| {
-                            [face_name(i, false), face_name(i, true)].contains(spec.set.get_ref())
-                        });
-                        let Some(axis) = axis else {
-                            return Err(src.at(
-                                &spec.set,
-                                format!(
-                                    "a roller needs a grid face for its normal ({}); `{}` is not one",
-                                    faces.join(", "),
-                                    spec.set.get_ref()
-                                ),
-                            ));
-                        };
-                        prescribe(axis, 0.0, 0);
-                    }
-                }
-                BoundaryKind::Displacement => {
-                    let curve = curve_of(&spec.curve)?;
-                    let values = match (&spec.displacement, &gradient) {
-                        (Some(d), _) => displacement_of::<D>(d, src)?,
-                        (None, Some(_)) => [None; 3],
-                        (None, None) => {
-                            return Err(src.at(
-                                &spec.kind,
-                                "kind = displacement needs `displacement = { x = …, y = … }` or `gradient`",
-                            ));
-                        }
-                    };
-                    if explicit
-                        && (gradient.is_some() || values.iter().flatten().any(|u| *u != 0.0))
-                    {
-                        return Err(src.at(
-                            &spec.kind,
-                            "a non-zero displacement follows the implicit solver's load factor; the explicit solver holds nodes (fixed, roller, a zero displacement) or moves them at a constant velocity (kind = \"velocity\")",
-                        ));
-                    }
-                    match &gradient {
-                        None => {
-                            for (i, v) in values.iter().take(D).enumerate() {
-                                if let Some(v) = v {
-                                    prescribe(i, *v, curve);
-                                }
-                            }
-                        }
-                        Some(g) => {
-                            // Every component: u = d + G x at the node.
-                            for &v in nodes {
-                                let x = initial_nodes[v];
-                                for i in 0..D {
-                                    let u = values[i].unwrap_or(0.0)
-                                        + (0..D).map(|j| g[(i, j)] * x[j]).sum::<f64>();
-                                    dofs[v * D + i] = Some((u, curve as u16));
-                                }
-                            }
-                        }
-                    }
-                }
-                BoundaryKind::Velocity if explicit => {
-                    for (key, present) in [
-                        ("displacement", spec.displacement.is_some()),
-                        ("gradient", spec.gradient.is_some()),
-                        ("curve", spec.curve.is_some()),
-                    ] {
-                        if present {
-                            return Err(src.at(
-                                &spec.kind,
-                                format!("`{key}` applies to kind = displacement, not velocity"),
-                            ));
-                        }
-                    }
-                    let Some(v) = &spec.velocity else {
-                        return Err(src.at(
-                            &spec.kind,
-                            "kind = velocity needs `velocity = { x = …, y = … }` (m/s)",
-                        ));
-                    };
-                    let values = axes_of::<D>(v, "velocity", src)?;
-                    for (i, value) in values.iter().take(D).enumerate() {
-                        if let Some(value) = value {
-                            for &node in nodes {
-                                velocity_dofs[node * D + i] = Some(*value);
-                            }
-                        }
-                    }
-                }
-                BoundaryKind::Velocity => {
-                    return Err(src.at(
-                        &spec.kind,
-                        "kind = velocity needs the explicit solver; the implicit solver prescribes displacements (kind = displacement)",
-                    ));
-                }
-            }
-        }
-        let motion = match &scene.mesh.motion {
-            Some(spec) => Some(motion::motion_of(
-                spec,
-                sets,
-                &initial_nodes,
-                origin,
-                upper,
-                src,
-            )?),
-            None => None,
-        };
-        let constraints = SceneConstraints {
-            dofs,
-            curves: curves.clone(),
-            following,
-            motion,
-        };
 
         // Loads.
         let mut body_force: Vec<SVector<f64, D>> = Vec::new();
@@ -1363,63 +1155,6 @@ fn manufactured_force<const D: usize>(
         let b = torsion.body_force(curve.at(lambda) * alpha, &x0[q]) * v0[q];
         SVector::<f64, D>::from_fn(|i, _| if i < 2 { b[i] } else { 0.0 })
     })))
-}
-
-/// The components of a `displacement` table, checked against the
-/// dimension (at least one given).
-fn displacement_of<const D: usize>(
-    d: &Spanned<crate::format::Axes>,
-    src: &SceneSource,
-) -> Result<[Option<f64>; 3], SceneError> {
-    axes_of::<D>(d, "displacement", src)
-}
-
-/// The components of a per-axis table named `key`, checked against the
-/// dimension (at least one given, all finite).
-fn axes_of<const D: usize>(
-    d: &Spanned<crate::format::Axes>,
-    key: &str,
-    src: &SceneSource,
-) -> Result<[Option<f64>; 3], SceneError> {
-    let values = d.get_ref().get();
-    if let Some(axis) = (D..3).find(|&i| values[i].is_some()) {
-        return Err(src.at(d, format!("a {D}D scene has no {} component", AXES[axis])));
-    }
-    if values.iter().all(Option::is_none) {
-        return Err(src.at(d, format!("`{key}` needs at least one of x, y, z")));
-    }
-    if let Some(v) = values.iter().flatten().find(|v| !v.is_finite()) {
-        return Err(src.at(d, format!("`{key}` must be finite, got {v}")));
-    }
-    Ok(values)
-}
-
-/// The name of a boundary kind in scene files.
-fn boundary_kind_name(kind: BoundaryKind) -> &'static str {
-    match kind {
-        BoundaryKind::Fixed => "fixed",
-        BoundaryKind::Roller => "roller",
-        BoundaryKind::Displacement => "displacement",
-        BoundaryKind::Velocity => "velocity",
-    }
-}
-
-/// A `gradient`: `D` rows of `D` finite numbers.
-fn gradient_of<const D: usize>(
-    g: &Spanned<Vec<Vec<f64>>>,
-    src: &SceneSource,
-) -> Result<nalgebra::SMatrix<f64, D, D>, SceneError> {
-    let rows = g.get_ref();
-    if rows.len() != D || rows.iter().any(|r| r.len() != D) {
-        return Err(src.at(
-            g,
-            format!("`gradient` must be {D} rows of {D} numbers in a {D}D scene"),
-        ));
-    }
-    if rows.iter().flatten().any(|v| !v.is_finite()) {
-        return Err(src.at(g, "`gradient` must be finite"));
-    }
-    Ok(nalgebra::SMatrix::<f64, D, D>::from_fn(|i, j| rows[i][j]))
 }
 
 #[cfg(test)]
