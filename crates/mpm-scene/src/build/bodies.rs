@@ -31,6 +31,30 @@ pub(super) struct BuiltBodies<const D: usize> {
     pub(super) names: BTreeMap<String, usize>,
 }
 
+impl<const D: usize> BuiltBodies<D> {
+    /// Number of points.
+    pub(super) fn len(&self) -> usize {
+        self.points.position.len()
+    }
+
+    /// The points of the body named `body`, or all points without a name.
+    ///
+    /// # Errors
+    /// [`SceneError::Scene`] at a name that is not a body's.
+    pub(super) fn points_of(
+        &self,
+        body: &Option<Spanned<String>>,
+        src: &SceneSource,
+    ) -> Result<std::ops::Range<usize>, SceneError> {
+        Ok(match body {
+            Some(b) => self.bodies[lookup(&self.names, b, "body", src)?]
+                .points
+                .clone(),
+            None => 0..self.len(),
+        })
+    }
+}
+
 /// The bodies of `specs` on `mesh`, with the materials of
 /// `material_names` and `materials`; `explicit`: the scene runs the
 /// explicit solver (the only one that takes an initial velocity).

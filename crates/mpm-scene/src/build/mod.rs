@@ -8,6 +8,7 @@ mod bodies;
 mod conditions;
 mod curves;
 mod explicit_keys;
+mod loads;
 mod materials;
 mod mesh;
 mod motion;
@@ -30,10 +31,11 @@ use crate::material::{MaterialModel, MaterialParams};
 use crate::source::SceneSource;
 use crate::variant::{LockingKind, Variant};
 
-use crate::format::{Axes, Field, LoadKind, Scene, TransferKind};
-use crate::region::{Region, point};
+use crate::format::{Axes, Field, Scene, TransferKind};
+use crate::region::Region;
 
 pub use explicit_keys::{DEFAULT_CFL, DEFAULT_OUTPUTS};
+pub use loads::MANUFACTURED_FIELDS;
 pub use motion::SceneMotion;
 
 /// Largest number of grid nodes, simplices or material points a scene may
@@ -596,8 +598,6 @@ impl<const D: usize> Problem<D> {
 
         // Curves (index 0: the default ramp).
         let curve_table = curves::curves(&scene.curves, src)?;
-        let curves = &curve_table.curves;
-        let curve_of = |name: &Option<Spanned<String>>| curve_table.index(name, src);
 
         // Materials.
         let (material_names, materials) = materials::materials(&scene.materials, explicit, src)?;
@@ -621,6 +621,17 @@ impl<const D: usize> Problem<D> {
         let constraints = conditions.constraints;
         let velocity_dofs = conditions.velocity_dofs;
 
+        // Loads.
+        let loads = loads::loads(
+            &scene.loads,
+            &built_bodies,
+            &materials,
+            &curve_table,
+            &node_sets.faces,
+            explicit,
+            src,
+        )?;
+
         let mesh::BuiltMesh {
             mesh,
             padding,
@@ -630,282 +641,15 @@ impl<const D: usize> Problem<D> {
         } = built_mesh;
         let bodies::BuiltBodies {
             bodies,
-            regions,
             points: problem_points,
             velocity: mut initial_velocity,
             names: body_names,
+            ..
         } = built_bodies;
         let n = problem_points.position.len();
 
-        let faces = &node_sets.faces;
         let set_of = |name: &Spanned<String>| node_sets.set_of(name, src);
-
-        // Loads.
-        let mut body_force: Vec<SVector<f64, D>> = Vec::new();
-        let mut point_forces = Vec::new();
-        let mut curved: BTreeMap<usize, Vec<SVector<f64, D>>> = BTreeMap::new();
-        let mut manufactured = Vec::new();
         let nearest = |x: &SVector<f64, D>| problem_points.nearest(x);
-        let mut explicit_gravity = SVector::<f64, D>::zeros();
-        let mut explicit_forces: Vec<(usize, SVector<f64, D>)> = Vec::new();
-        let mut timed_forces: Vec<TimedForces<D>> = Vec::new();
-        for spec in &scene.loads {
-            let kind = *spec.kind.get_ref();
-            let curve = curve_of(&spec.curve)?;
-            let refuse = |key: &str, applies: &str| {
-                src.at(
-                    &spec.kind,
-                    format!("`{key}` applies to kind = {applies} loads"),
-                )
-            };
-            // Keys that belong to other kinds.
-            let present: [(&str, bool, LoadKind); 8] = [
-                (
-                    "acceleration",
-                    spec.acceleration.is_some(),
-                    LoadKind::Gravity,
-                ),
-                ("force", spec.force.is_some(), LoadKind::Point),
-                ("at", spec.at.is_some(), LoadKind::Point),
-                ("region", spec.region.is_some(), LoadKind::Point),
-                ("traction", spec.traction.is_some(), LoadKind::Traction),
-                ("side", spec.side.is_some(), LoadKind::Traction),
-                ("field", spec.field.is_some(), LoadKind::Manufactured),
-                (
-                    "parameters",
-                    spec.parameters.is_some(),
-                    LoadKind::Manufactured,
-                ),
-            ];
-            for (key, given, owner) in present {
-                if given && owner != kind {
-                    let name = match owner {
-                        LoadKind::Gravity => "gravity",
-                        LoadKind::Point => "point",
-                        LoadKind::Traction => "traction",
-                        LoadKind::Manufactured => "manufactured",
-                    };
-                    return Err(refuse(key, name));
-                }
-            }
-            if explicit {
-                match kind {
-                    LoadKind::Manufactured => {
-                        return Err(src.at(
-                            &spec.kind,
-                            "a manufactured load balances a quasi-static solution; the explicit solver does not take it",
-                        ));
-                    }
-                    // A gravity load with a curve is a force m_p g c(t) on
-                    // each point (below), its work external work.
-                    LoadKind::Gravity if curve == 0 => {
-                        if let Some(b) = &spec.body {
-                            return Err(src.at(
-                                b,
-                                "an explicit gravity load without a curve is the solver's gravitational field, on every body: leave out `body` (or give a `curve` to load one body's points)",
-                            ));
-                        }
-                        let Some(a) = &spec.acceleration else {
-                            return Err(src.at(&spec.kind, "a gravity load needs `acceleration`"));
-                        };
-                        explicit_gravity += point::<D>(a, "`acceleration`", src)?;
-                        continue;
-                    }
-                    LoadKind::Gravity | LoadKind::Point | LoadKind::Traction => {}
-                }
-            }
-            let mut forces: Vec<SVector<f64, D>> = Vec::new();
-            let add = |p: usize, f: SVector<f64, D>, forces: &mut Vec<SVector<f64, D>>| {
-                if forces.is_empty() {
-                    forces.resize(n, SVector::zeros());
-                }
-                forces[p] += f;
-            };
-            match kind {
-                LoadKind::Manufactured => {
-                    let range = match &spec.body {
-                        Some(b) => bodies[lookup(&body_names, b, "body", src)?].points.clone(),
-                        None => 0..n,
-                    };
-                    let shear_modulus: Vec<f64> = problem_points
-                        .material
-                        .iter()
-                        .map(|&m| {
-                            let p = &materials[m as usize].params;
-                            p.youngs_modulus / (2.0 * (1.0 + p.poisson_ratio))
-                        })
-                        .collect();
-                    manufactured.push(manufactured_force::<D>(
-                        spec,
-                        range,
-                        &problem_points.position,
-                        &problem_points.volume,
-                        shear_modulus,
-                        curves[curve].clone(),
-                        src,
-                    )?);
-                    continue;
-                }
-                LoadKind::Gravity => {
-                    let Some(a) = &spec.acceleration else {
-                        return Err(src.at(&spec.kind, "a gravity load needs `acceleration`"));
-                    };
-                    let g = point::<D>(a, "`acceleration`", src)?;
-                    let range = match &spec.body {
-                        Some(b) => bodies[lookup(&body_names, b, "body", src)?].points.clone(),
-                        None => 0..n,
-                    };
-                    for p in range {
-                        add(p, g * problem_points.mass[p], &mut forces);
-                    }
-                }
-                LoadKind::Point => {
-                    if spec.body.is_some() {
-                        return Err(refuse("body", "gravity or traction"));
-                    }
-                    let Some(f) = &spec.force else {
-                        return Err(src.at(&spec.kind, "a point load needs `force`"));
-                    };
-                    let f = point::<D>(f, "`force`", src)?;
-                    match (&spec.at, &spec.region) {
-                        (Some(at), None) => {
-                            let x = point::<D>(at, "`at`", src)?;
-                            add(nearest(&x), f, &mut forces);
-                        }
-                        (None, Some(r)) => {
-                            let region = Region::<D>::new(r, src)?;
-                            let inside: Vec<usize> = (0..n)
-                                .filter(|&p| region.contains(&problem_points.position[p]))
-                                .collect();
-                            if inside.is_empty() {
-                                return Err(src.at(
-                                    &spec.kind,
-                                    "the point load's region holds no material point",
-                                ));
-                            }
-                            let share = f / inside.len() as f64;
-                            for p in inside {
-                                add(p, share, &mut forces);
-                            }
-                        }
-                        _ => {
-                            return Err(
-                                src.at(&spec.kind, "a point load needs one of `at` or `region`")
-                            );
-                        }
-                    }
-                }
-                LoadKind::Traction => {
-                    let (Some(t), Some(side), Some(b)) = (&spec.traction, &spec.side, &spec.body)
-                    else {
-                        return Err(src.at(
-                            &spec.kind,
-                            "a traction load needs `traction`, `side` and `body`",
-                        ));
-                    };
-                    let t = point::<D>(t, "`traction`", src)?;
-                    let k = lookup(&body_names, b, "body", src)?;
-                    let face = (0..D)
-                        .flat_map(|i| [(i, false), (i, true)])
-                        .find(|&(i, up)| face_name(i, up) == *side.get_ref());
-                    let Some((axis, up)) = face else {
-                        return Err(
-                            src.at(side, format!("`side` must be one of {}", faces.join(", ")))
-                        );
-                    };
-                    let body = &bodies[k];
-                    let Some(body_region) = &regions[k] else {
-                        return Err(src.at(
-                            &spec.kind,
-                            "traction loads need a body given by a region on a grid",
-                        ));
-                    };
-                    if body.step.is_empty() {
-                        return Err(src.at(
-                            &spec.kind,
-                            "traction loads need a body on a grid (simplex bodies have no lattice)",
-                        ));
-                    }
-                    let mut offset = SVector::<f64, D>::zeros();
-                    offset[axis] = if up {
-                        body.step[axis]
-                    } else {
-                        -body.step[axis]
-                    };
-                    let mut loaded = 0;
-                    for p in body.points.clone() {
-                        let x = problem_points.position[p];
-                        if !body_region.contains(&(x + offset)) {
-                            // The point's face area on that side.
-                            let area = problem_points.volume[p] / body.step[axis];
-                            add(p, t * area, &mut forces);
-                            loaded += 1;
-                        }
-                    }
-                    if loaded == 0 {
-                        return Err(src.at(
-                            side,
-                            format!(
-                                "body `{}` has no points on side {}",
-                                body.name,
-                                side.get_ref()
-                            ),
-                        ));
-                    }
-                }
-            }
-            if forces.is_empty() {
-                continue;
-            }
-            if explicit {
-                // Point loads and tractions: constant forces on their
-                // points, or forces scaled by their curve over time.
-                let nonzero = forces
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, f)| **f != SVector::<f64, D>::zeros())
-                    .map(|(p, f)| (p, *f));
-                if curve == 0 {
-                    explicit_forces.extend(nonzero);
-                } else {
-                    timed_forces.push(TimedForces {
-                        curve: curves[curve].clone(),
-                        forces: nonzero.collect(),
-                    });
-                }
-                continue;
-            }
-            if curve == 0 {
-                if kind == LoadKind::Point {
-                    point_forces.extend(
-                        forces
-                            .iter()
-                            .enumerate()
-                            .filter(|(_, f)| **f != SVector::<f64, D>::zeros())
-                            .map(|(p, f)| (p, *f)),
-                    );
-                } else if body_force.is_empty() {
-                    body_force = forces;
-                } else {
-                    body_force
-                        .iter_mut()
-                        .zip(&forces)
-                        .for_each(|(a, b)| *a += b);
-                }
-            } else {
-                let entry = curved
-                    .entry(curve)
-                    .or_insert_with(|| vec![SVector::zeros(); n]);
-                entry.iter_mut().zip(&forces).for_each(|(a, b)| *a += b);
-            }
-        }
-        let curved = curved
-            .into_iter()
-            .map(|(k, force)| CurvedForces {
-                curve: curves[k].clone(),
-                force,
-            })
-            .collect();
 
         // Solver.
         let s = &scene.solver;
@@ -1010,11 +754,11 @@ impl<const D: usize> Problem<D> {
                 transfer: k.transfer,
                 alpha: k.alpha,
                 locking: k.locking,
-                gravity: explicit_gravity,
+                gravity: loads.explicit.gravity,
                 fixities,
                 velocity: initial_velocity,
-                point_forces: explicit_forces,
-                timed_forces,
+                point_forces: loads.explicit.forces,
+                timed_forces: loads.explicit.timed,
                 point_fixities,
             }
         });
@@ -1032,10 +776,10 @@ impl<const D: usize> Problem<D> {
             material_of_point: problem_points.material,
             body_of_point: problem_points.body,
             constraints,
-            body_force,
-            point_forces,
-            curved,
-            manufactured,
+            body_force: loads.body_force,
+            point_forces: loads.point_forces,
+            curved: loads.curved,
+            manufactured: loads.manufactured,
             stepping,
             newton,
             variant,
@@ -1058,103 +802,6 @@ impl<const D: usize> Problem<D> {
     pub fn is_empty(&self) -> bool {
         self.position.is_empty()
     }
-}
-
-/// The manufactured fields `kind = "manufactured"` loads can name, with
-/// their parameters.
-pub const MANUFACTURED_FIELDS: [(&str, &[&str]); 1] = [(
-    "annulus_torsion",
-    &["inner_radius", "outer_radius", "alpha"],
-)];
-
-/// The body force of a `manufactured` load on the points `range` (the
-/// other points get none), per point at load factor λ: the field's force
-/// per unit volume at amplitude `curve(λ)` times the point's volume.
-#[allow(clippy::too_many_arguments)]
-fn manufactured_force<const D: usize>(
-    spec: &crate::format::LoadSpec,
-    range: std::ops::Range<usize>,
-    position: &[SVector<f64, D>],
-    volume: &[f64],
-    shear_modulus: Vec<f64>,
-    curve: Curve,
-    src: &SceneSource,
-) -> Result<BodyForcePath<D>, SceneError> {
-    use std::sync::Arc;
-    let Some(field) = &spec.field else {
-        return Err(src.at(
-            &spec.kind,
-            format!(
-                "a manufactured load needs `field` (one of {})",
-                MANUFACTURED_FIELDS.map(|f| f.0).join(", ")
-            ),
-        ));
-    };
-    let Some((name, keys)) = MANUFACTURED_FIELDS
-        .iter()
-        .find(|(name, _)| name == field.get_ref())
-    else {
-        return Err(src.at(
-            field,
-            format!(
-                "unknown manufactured field `{}`; the fields are: {}",
-                field.get_ref(),
-                MANUFACTURED_FIELDS.map(|f| f.0).join(", ")
-            ),
-        ));
-    };
-    let empty = Spanned::new(field.span(), BTreeMap::new());
-    let given = spec.parameters.as_ref().unwrap_or(&empty);
-    if let Some(k) = given.get_ref().keys().find(|k| !keys.contains(&k.as_str())) {
-        return Err(src.at(
-            given,
-            format!(
-                "field `{name}` has no parameter `{k}`; it takes {}",
-                keys.join(", ")
-            ),
-        ));
-    }
-    let value = |key: &str| -> Result<f64, SceneError> {
-        match given.get_ref().get(key) {
-            Some(v) if v.is_finite() => Ok(*v),
-            Some(v) => Err(src.at(given, format!("`{key}` must be finite, got {v}"))),
-            None => Err(src.at(
-                given,
-                format!(
-                    "field `{name}` needs `parameters = {{ {} }}`",
-                    keys.join(", ")
-                ),
-            )),
-        }
-    };
-    if D != 2 {
-        return Err(src.at(field, format!("field `{name}` is a 2D field")));
-    }
-    let (inner, outer, alpha) = (value(keys[0])?, value(keys[1])?, value(keys[2])?);
-    if !(0.0 < inner && inner < outer) {
-        return Err(src.at(
-            given,
-            format!("`inner_radius` {inner} and `outer_radius` {outer} need 0 < inner < outer"),
-        ));
-    }
-    // Coombs et al. 2020 §7.4, eq. (44): see `manufactured::Torsion`.
-    let x0: Vec<nalgebra::Vector2<f64>> = position
-        .iter()
-        .map(|x| nalgebra::Vector2::new(x[0], x[1]))
-        .collect();
-    let v0 = volume.to_vec();
-    Ok(BodyForcePath(Arc::new(move |q: usize, lambda: f64| {
-        if !range.contains(&q) {
-            return SVector::zeros();
-        }
-        let torsion = crate::manufactured::Torsion {
-            inner_radius: inner,
-            outer_radius: outer,
-            mu: shear_modulus[q],
-        };
-        let b = torsion.body_force(curve.at(lambda) * alpha, &x0[q]) * v0[q];
-        SVector::<f64, D>::from_fn(|i, _| if i < 2 { b[i] } else { 0.0 })
-    })))
 }
 
 #[cfg(test)]
