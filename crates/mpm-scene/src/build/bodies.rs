@@ -53,6 +53,17 @@ impl<const D: usize> BuiltBodies<D> {
             None => 0..self.len(),
         })
     }
+
+    /// The points of `range` that lie in `region`.
+    pub(super) fn points_in(
+        &self,
+        range: std::ops::Range<usize>,
+        region: &Region<D>,
+    ) -> Vec<usize> {
+        range
+            .filter(|&p| region.contains(&self.points.position[p]))
+            .collect()
+    }
 }
 
 /// The bodies of `specs` on `mesh`, with the materials of

@@ -232,9 +232,7 @@ impl<const D: usize> Reader<'_, D> {
             }
             (None, Some(r)) => {
                 let region = Region::<D>::new(r, src)?;
-                let inside: Vec<usize> = (0..self.bodies.len())
-                    .filter(|&p| region.contains(&points.position[p]))
-                    .collect();
+                let inside = self.bodies.points_in(0..self.bodies.len(), &region);
                 if inside.is_empty() {
                     return Err(src.at(
                         &spec.kind,

@@ -3,11 +3,22 @@
 //! Dirichlet conditions, the loads and the controls. Every check across
 //! sections happens here, before anything is run or written, and each
 //! error names the place in the file (or the override) it comes from.
+//!
+//! [`Problem::build_in`] reads as its stages, in the order their errors
+//! are found, each in its file: the solver's kind and variant
+//! (`explicit_keys.rs`, `solver.rs`), the mesh (`mesh.rs`), the curves
+//! and materials (`curves.rs`, `materials.rs`), the bodies and their
+//! points (`bodies.rs`), the node sets (`node_sets.rs`), the conditions
+//! and mesh motion (`conditions.rs`, `motion.rs`), the loads
+//! (`loads.rs`), the implicit solver's controls (`solver.rs`), the
+//! outputs (`outputs.rs`) and an explicit run's setup (`explicit_run.rs`).
+//! This file keeps the types they build and the checks they share.
 
 mod bodies;
 mod conditions;
 mod curves;
 mod explicit_keys;
+mod explicit_run;
 mod loads;
 mod materials;
 mod mesh;
@@ -32,7 +43,6 @@ use crate::source::SceneSource;
 use crate::variant::{LockingKind, Variant};
 
 use crate::format::{Axes, Field, Scene, TransferKind};
-use crate::region::Region;
 
 pub use explicit_keys::{DEFAULT_CFL, DEFAULT_OUTPUTS};
 pub use loads::MANUFACTURED_FIELDS;
@@ -574,208 +584,61 @@ impl<const D: usize> Problem<D> {
         basis_padding: usize,
         mesh_dir: &std::path::Path,
     ) -> Result<Self, SceneError> {
-        let solver = &scene.solver;
-        let explicit_keys = explicit_keys::solver_keys(solver, src)?;
+        let s = &scene.solver;
+        // The solver's kind and the variant decide what the rest may be.
+        let explicit_keys = explicit_keys::solver_keys(s, src)?;
         let explicit = explicit_keys.is_some();
-        let variant = Variant {
-            basis: solver.basis(),
-            formulation: *solver.formulation.get_ref(),
-            locking: *solver.locking.get_ref(),
-            domain_update: *solver.domain_update.get_ref(),
-            gimp_volume: *solver.gimp_volume.get_ref(),
-        };
-        // The basis and domain rule must fit whatever the mesh (the rest of
-        // the table needs the mesh and is checked with it).
-        if let Some(message) =
-            crate::rules::domain_update_fits_basis(&variant, crate::rules::Context::ImplicitGrid)
-        {
-            return Err(src.at(&solver.domain_update, message));
-        }
-        let basis_padding = basis_padding.max(solver.padding());
-
-        // Mesh.
-        let built_mesh = mesh::mesh::<D>(scene, &variant, explicit, basis_padding, mesh_dir, src)?;
-
-        // Curves (index 0: the default ramp).
-        let curve_table = curves::curves(&scene.curves, src)?;
-
-        // Materials.
+        let variant = solver::variant(s, src)?;
+        let basis_padding = basis_padding.max(s.padding());
+        let mesh = mesh::mesh::<D>(scene, &variant, explicit, basis_padding, mesh_dir, src)?;
+        let curves = curves::curves(&scene.curves, src)?;
         let (material_names, materials) = materials::materials(&scene.materials, explicit, src)?;
-
-        // Bodies.
-        let built_bodies = bodies::bodies(
+        let bodies = bodies::bodies(
             &scene.bodies,
-            &built_mesh,
+            &mesh,
             &material_names,
             &materials,
             explicit,
             src,
         )?;
-
-        // Node sets: the faces, then the named ones.
-        let node_sets = node_sets::node_sets(&scene.node_sets, &built_mesh, &built_bodies, src)?;
-
-        // Conditions: boundaries, then the mesh motion.
-        let conditions =
-            conditions::conditions(scene, &built_mesh, &node_sets, &curve_table, explicit, src)?;
-        let constraints = conditions.constraints;
-        let velocity_dofs = conditions.velocity_dofs;
-
-        // Loads.
+        let sets = node_sets::node_sets(&scene.node_sets, &mesh, &bodies, src)?;
+        let conditions = conditions::conditions(scene, &mesh, &sets, &curves, explicit, src)?;
         let loads = loads::loads(
             &scene.loads,
-            &built_bodies,
+            &bodies,
             &materials,
-            &curve_table,
-            &node_sets.faces,
+            &curves,
+            &sets.faces,
             explicit,
             src,
         )?;
-
-        let mesh::BuiltMesh {
-            mesh,
-            padding,
-            patch_of_element,
-            warnings,
-            ..
-        } = built_mesh;
-        let bodies::BuiltBodies {
-            bodies,
-            points: problem_points,
-            velocity: mut initial_velocity,
-            names: body_names,
-            ..
-        } = built_bodies;
-        let n = problem_points.position.len();
-
-        let set_of = |name: &Spanned<String>| node_sets.set_of(name, src);
-        let nearest = |x: &SVector<f64, D>| problem_points.nearest(x);
-
-        // Solver.
-        let s = &scene.solver;
         let (stepping, newton) =
-            solver::newton_and_stepping(s, src, matches!(mesh, SceneMesh::Grid(_)))?;
+            solver::newton_and_stepping(s, src, matches!(mesh.mesh, SceneMesh::Grid(_)))?;
+        let (every, reactions, probes, fields) = outputs::outputs::<D>(
+            &scene.output,
+            explicit,
+            src,
+            &|name| sets.set_of(name, src),
+            &|x| bodies.points.nearest(x),
+        )?;
+        let explicit =
+            explicit_run::explicit_run(explicit_keys, scene, &mesh, &materials, &bodies, src)?
+                .map(|run| run.setup(&conditions.velocity_dofs, loads.explicit));
 
-        // Outputs.
-        let o = &scene.output;
-        let (every, reactions, probes, fields) =
-            outputs::outputs::<D>(o, explicit, src, &set_of, &nearest)?;
-        // A CFL step is h / max(c + |v|) over the initial points (the
-        // solver computes the signal speed once): the fixed `time_step`'s
-        // bound of 1e9 steps, applied before running.
-        if let (Some(k), SceneMesh::Grid(grid)) = (&explicit_keys, &mesh)
-            && let mpm_solver::TimeStep::Cfl { factor } = k.time_step
-        {
-            let wave = |m: &BuiltMaterial| {
-                let (e, nu) = (m.params.youngs_modulus, m.params.poisson_ratio);
-                (e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)) / m.density).sqrt()
-            };
-            let c = materials.iter().map(wave).fold(0.0, f64::max);
-            let v = initial_velocity
-                .iter()
-                .map(|v| v.norm())
-                .fold(0.0, f64::max);
-            let steps = k.end_time * (c + v) / (factor * grid.spacing().min());
-            if steps.is_nan() || steps > 1e9 {
-                let at = solver
-                    .cfl
-                    .as_ref()
-                    .map_or(solver.kind.span(), Spanned::span);
-                return Err(src.error(
-                    Some(at),
-                    &format!("solver `cfl` {factor:e} would take {steps:.1e} steps of h / max(c + |v|) to reach end_time {}; more than 1e9", k.end_time),
-                ));
-            }
-        }
-        // Material-point fixities (explicit solver).
-        let mut point_fixities: Vec<(usize, usize, f64)> = Vec::new();
-        for spec in &scene.point_fixities {
-            if !explicit {
-                return Err(src.at(
-                    &spec.velocity,
-                    "material-point fixities are a condition of the explicit solver ([solver] kind = \"explicit\"); the implicit solver holds nodes ([[boundary]])",
-                ));
-            }
-            let values = axes_of::<D>(&spec.velocity, "velocity", src)?;
-            let range = match &spec.body {
-                Some(b) => bodies[lookup(&body_names, b, "body", src)?].points.clone(),
-                None => 0..n,
-            };
-            let region = Region::<D>::new(&spec.region, src)?;
-            let held: Vec<usize> = range
-                .filter(|&p| region.contains(&problem_points.position[p]))
-                .collect();
-            if held.is_empty() {
-                return Err(src.at(
-                    &spec.velocity,
-                    "the point fixity's region holds no material point",
-                ));
-            }
-            for p in held {
-                for (c, v) in values.iter().take(D).enumerate() {
-                    if let Some(v) = v {
-                        point_fixities.push((p, c, *v));
-                    }
-                }
-            }
-        }
-        // Sorted by point and component, a later fixity of the same
-        // component replacing an earlier one: the rule of the solver's
-        // nodal fixities, whose list serves points as well.
-        let mut sorted = mpm_solver::VelocityFixities::new();
-        for &(p, c, v) in &point_fixities {
-            sorted.prescribe([p], c, v);
-        }
-        sorted.finish();
-        let point_fixities = sorted.entries().to_vec();
-        // A held point starts at its held velocity.
-        for &(p, c, v) in &point_fixities {
-            initial_velocity[p][c] = v;
-        }
-        let explicit = explicit_keys.map(|k| {
-            // One call per component and value (each call sorts the list).
-            let mut groups: BTreeMap<(usize, u64), Vec<usize>> = BTreeMap::new();
-            for (dof, v) in velocity_dofs.iter().enumerate() {
-                if let Some(v) = v {
-                    groups
-                        .entry((dof % D, v.to_bits()))
-                        .or_default()
-                        .push(dof / D);
-                }
-            }
-            let mut fixities = mpm_solver::VelocityFixities::new();
-            for ((component, bits), nodes) in groups {
-                fixities.prescribe(nodes, component, f64::from_bits(bits));
-            }
-            ExplicitSetup {
-                end_time: k.end_time,
-                output_interval: k.output_interval,
-                time_step: k.time_step,
-                transfer: k.transfer,
-                alpha: k.alpha,
-                locking: k.locking,
-                gravity: loads.explicit.gravity,
-                fixities,
-                velocity: initial_velocity,
-                point_forces: loads.explicit.forces,
-                timed_forces: loads.explicit.timed,
-                point_fixities,
-            }
-        });
-
+        let points = bodies.points;
         Ok(Self {
-            warnings,
-            mesh,
-            padding,
-            bodies,
+            warnings: mesh.warnings,
+            mesh: mesh.mesh,
+            padding: mesh.padding,
+            bodies: bodies.bodies,
             materials,
-            position: problem_points.position,
-            volume: problem_points.volume,
-            half_lengths: problem_points.half_lengths,
-            mass: problem_points.mass,
-            material_of_point: problem_points.material,
-            body_of_point: problem_points.body,
-            constraints,
+            position: points.position,
+            volume: points.volume,
+            half_lengths: points.half_lengths,
+            mass: points.mass,
+            material_of_point: points.material,
+            body_of_point: points.body,
+            constraints: conditions.constraints,
             body_force: loads.body_force,
             point_forces: loads.point_forces,
             curved: loads.curved,
@@ -783,12 +646,12 @@ impl<const D: usize> Problem<D> {
             stepping,
             newton,
             variant,
-            patch_of_element,
+            patch_of_element: mesh.patch_of_element,
             reactions,
             probes,
             every,
             fields,
-            png: o.png,
+            png: scene.output.png,
             explicit,
         })
     }
