@@ -491,6 +491,16 @@ fn grid_mesh<const D: usize>(
         Some(p) => *p.get_ref(),
         None => basis_padding,
     };
+    // A padding that alone passes the limit is refused at its key before
+    // `2 * padding` is formed: TOML integers reach u64::MAX, and from
+    // 2^63 on the double wrapped (a grid without its padding, in release).
+    if padding > MAX_ENTITIES {
+        let at = m.padding.as_ref().map_or(size_spec.span(), Spanned::span);
+        return Err(src.error(
+            Some(at),
+            &format!("the grid would have more than {MAX_ENTITIES} nodes"),
+        ));
+    }
     let spacing = SVector::<f64, D>::from_fn(|i, _| size[i] / cells[i] as f64);
     let padded: [usize; D] = std::array::from_fn(|i| cells[i].saturating_add(2 * padding));
     let nodes = padded
@@ -592,4 +602,85 @@ fn rectilinear<const D: usize>(
         let f = t - i as f64;
         row[i] + f * (row[i + 1] - row[i])
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Problem, SceneError};
+
+    /// A 2 x 2 grid with `padding` on line 6, column 11.
+    fn scene(padding: &str) -> String {
+        format!(
+            r#"[mesh]
+origin = [0.0, 0.0]
+size = [1.0, 1.0]
+cells = [2, 2]
+# `padding` is the only key the test varies.
+padding = {padding}
+
+[[material]]
+name = "m"
+model = "hencky"
+youngs_modulus = 1.0e6
+poisson_ratio = 0.0
+density = 1.0
+
+[[body]]
+name = "b"
+material = "m"
+region = {{ box = {{ lower = [0.0, 0.0], upper = [1.0, 1.0] }} }}
+points_per_cell = 2
+"#
+        )
+    }
+
+    fn build(text: &str, set: &[String]) -> Result<Problem<2>, SceneError> {
+        let (scene, src) = crate::parse(text, "s.toml", set)?;
+        Problem::<2>::build_in(
+            &scene,
+            &src,
+            scene.solver.padding(),
+            std::path::Path::new("."),
+        )
+    }
+
+    /// TOML integers reach u64::MAX: a padding of 2^63 or more made
+    /// `2 * padding` wrap (in release; a panic in debug), to a grid
+    /// built without its padding (2^63) or with a padding of 1 each side
+    /// (2^63 + 1) while `Problem::padding` said 2^63. Refused at the key,
+    /// in the file and as an override.
+    #[test]
+    fn a_padding_whose_double_overflows_is_refused_at_the_key() {
+        let huge = [
+            "9223372036854775808",
+            "9223372036854775809",
+            "18446744073709551615",
+            "9223372036854775807",
+            "50000001",
+        ];
+        for p in huge {
+            match build(&scene(p), &[]) {
+                Err(SceneError::Scene {
+                    line: 6,
+                    column: 11,
+                    message,
+                    ..
+                }) => assert!(
+                    message.contains("the grid would have more than 50000000 nodes"),
+                    "padding = {p}: {message}"
+                ),
+                other => panic!("padding = {p}: {:?}", other.map(|b| b.padding)),
+            }
+            match build(&scene("1"), &[format!("mesh.padding={p}")]) {
+                Err(SceneError::Override { message, .. }) => assert!(
+                    message.contains("the grid would have more than 50000000 nodes"),
+                    "--set mesh.padding={p}: {message}"
+                ),
+                other => panic!("--set mesh.padding={p}: {:?}", other.map(|b| b.padding)),
+            }
+        }
+        let built = build(&scene("3"), &[]).expect("a padding of 3 builds");
+        assert_eq!(built.padding, 3);
+        assert_eq!(built.mesh.node_count(), 9 * 9);
+    }
 }
