@@ -3,20 +3,44 @@
 
 use std::collections::BTreeMap;
 
-use super::{Curve, unique_names};
+use toml::Spanned;
+
+use super::{Curve, lookup, unique_names};
 use crate::SceneError;
 use crate::format::CurveSpec;
 use crate::source::SceneSource;
 
-/// The curves' names (for the loads' lookups; a name's index is its
-/// curve's minus one) and the curves, the default ramp first.
+/// The curves of a scene, by index and by name.
+pub(super) struct CurveTable {
+    /// Curve index by name (a name's index is its curve's minus one).
+    names: BTreeMap<String, usize>,
+    /// The curves, the default ramp first.
+    pub(super) curves: Vec<Curve>,
+}
+
+impl CurveTable {
+    /// The index of the curve `name`: 0, the default ramp, without one.
+    ///
+    /// # Errors
+    /// [`SceneError::Scene`] at a name that is not a curve's.
+    pub(super) fn index(
+        &self,
+        name: &Option<Spanned<String>>,
+        src: &SceneSource,
+    ) -> Result<usize, SceneError> {
+        match name {
+            None => Ok(0),
+            Some(n) => lookup(&self.names, n, "curve", src).map(|k| k + 1),
+        }
+    }
+}
+
+/// The curves' names (for the conditions' and loads' lookups) and the
+/// curves, the default ramp first.
 ///
 /// # Errors
 /// [`SceneError::Scene`] at the curve whose rows are wrong.
-pub(super) fn curves(
-    specs: &[CurveSpec],
-    src: &SceneSource,
-) -> Result<(BTreeMap<String, usize>, Vec<Curve>), SceneError> {
+pub(super) fn curves(specs: &[CurveSpec], src: &SceneSource) -> Result<CurveTable, SceneError> {
     let curve_names = unique_names(specs.iter().map(|c| &c.name), "curve", src)?;
     let mut curves = vec![Curve::ramp()];
     for c in specs {
@@ -56,5 +80,8 @@ pub(super) fn curves(
     if curves.len() > u16::MAX as usize {
         return Err(src.error(None, "too many curves"));
     }
-    Ok((curve_names, curves))
+    Ok(CurveTable {
+        names: curve_names,
+        curves,
+    })
 }

@@ -1,4 +1,5 @@
-//! The `[solver]` keys of the implicit solver: load stepping and Newton
+//! The `[solver]` keys of the variant (basis, formulation, locking,
+//! domain update) and of the implicit solver: load stepping and Newton
 //! controls, each value checked at its key.
 
 use mpm_solver::{LoadStepping, NewtonOptions};
@@ -7,7 +8,29 @@ use super::Check;
 use crate::SceneError;
 use crate::format::{LinearKind, SolverSpec};
 use crate::source::SceneSource;
+use crate::variant::Variant;
 use toml::Spanned;
+
+/// The variant `s` names; its basis and domain rule must fit whatever the
+/// mesh (the rest of the table needs the mesh and is checked with it).
+///
+/// # Errors
+/// [`SceneError::Scene`] at `domain_update`.
+pub(super) fn variant(s: &SolverSpec, src: &SceneSource) -> Result<Variant, SceneError> {
+    let variant = Variant {
+        basis: s.basis(),
+        formulation: *s.formulation.get_ref(),
+        locking: *s.locking.get_ref(),
+        domain_update: *s.domain_update.get_ref(),
+        gimp_volume: *s.gimp_volume.get_ref(),
+    };
+    if let Some(message) =
+        crate::rules::domain_update_fits_basis(&variant, crate::rules::Context::ImplicitGrid)
+    {
+        return Err(src.at(&s.domain_update, message));
+    }
+    Ok(variant)
+}
 
 /// The load stepping and Newton options of `s`; `grid`: the scene's mesh
 /// is a regular grid (the ghost penalty acts on its cells' faces).
