@@ -91,21 +91,19 @@ pub(super) fn mesh<const D: usize>(
     if explicit {
         explicit_grid(m, &scene.solver, src)?;
     }
-    let annulus_key = [
-        m.inner_radius.as_ref().map(Spanned::span),
-        m.outer_radius.as_ref().map(Spanned::span),
-        m.layers.as_ref().map(Spanned::span),
-        m.ring_nodes.as_ref().map(Spanned::span),
-        m.jitter.as_ref().map(Spanned::span),
-        m.seed.as_ref().map(Spanned::span),
-    ]
-    .into_iter()
-    .flatten()
-    .next();
-    if m.kind != MeshKind::Annulus
-        && let Some(span) = annulus_key
-    {
-        return Err(src.error(Some(span), "`inner_radius`, `outer_radius`, `layers`, `ring_nodes`, `jitter` and `seed` apply to kind = \"annulus\" meshes"));
+    if m.kind != MeshKind::Annulus {
+        refuse_first(
+            src,
+            [
+                m.inner_radius.as_ref().map(Spanned::span),
+                m.outer_radius.as_ref().map(Spanned::span),
+                m.layers.as_ref().map(Spanned::span),
+                m.ring_nodes.as_ref().map(Spanned::span),
+                m.jitter.as_ref().map(Spanned::span),
+                m.seed.as_ref().map(Spanned::span),
+            ],
+            "`inner_radius`, `outer_radius`, `layers`, `ring_nodes`, `jitter` and `seed` apply to kind = \"annulus\" meshes",
+        )?;
     }
     let mut built = match m.kind {
         MeshKind::Annulus => annulus(m, variant, src)?,
@@ -147,20 +145,21 @@ fn annulus<const D: usize>(
     src: &SceneSource,
 ) -> Result<BuiltMesh<D>, SceneError> {
     let check = Check { src };
-    let misplaced = [
-        m.origin.as_ref().map(Spanned::span),
-        m.size.as_ref().map(Spanned::span),
-        m.cells.as_ref().map(Spanned::span),
-        m.spacing.as_ref().map(Spanned::span),
-        m.padding.as_ref().map(Spanned::span),
-        m.file.as_ref().map(Spanned::span),
-        m.dimension.as_ref().map(Spanned::span),
-        m.patches.as_ref().map(Spanned::span),
-        m.coordinates.as_ref().map(Spanned::span),
-    ];
-    if let Some(span) = misplaced.into_iter().flatten().next() {
-        return Err(src.error(Some(span), "an annulus mesh takes `inner_radius`, `outer_radius`, `layers`, `ring_nodes`, `jitter` and `seed`"));
-    }
+    refuse_first(
+        src,
+        [
+            m.origin.as_ref().map(Spanned::span),
+            m.size.as_ref().map(Spanned::span),
+            m.cells.as_ref().map(Spanned::span),
+            m.spacing.as_ref().map(Spanned::span),
+            m.padding.as_ref().map(Spanned::span),
+            m.file.as_ref().map(Spanned::span),
+            m.dimension.as_ref().map(Spanned::span),
+            m.patches.as_ref().map(Spanned::span),
+            m.coordinates.as_ref().map(Spanned::span),
+        ],
+        "an annulus mesh takes `inner_radius`, `outer_radius`, `layers`, `ring_nodes`, `jitter` and `seed`",
+    )?;
     if D != 2 {
         return Err(src.error(None, "an annulus mesh is 2D"));
     }
@@ -283,22 +282,17 @@ fn gmsh<const D: usize>(
     mesh_dir: &Path,
     src: &SceneSource,
 ) -> Result<BuiltMesh<D>, SceneError> {
-    let grid_key = [
-        m.origin.as_ref().map(Spanned::span),
-        m.size.as_ref().map(Spanned::span),
-        m.cells.as_ref().map(Spanned::span),
-        m.spacing.as_ref().map(Spanned::span),
-        m.padding.as_ref().map(Spanned::span),
-    ]
-    .into_iter()
-    .flatten()
-    .next();
-    if let Some(span) = grid_key {
-        return Err(src.error(
-            Some(span),
-            "`origin`, `size`, `cells`, `spacing` and `padding` apply to kind = \"grid\" meshes",
-        ));
-    }
+    refuse_first(
+        src,
+        [
+            m.origin.as_ref().map(Spanned::span),
+            m.size.as_ref().map(Spanned::span),
+            m.cells.as_ref().map(Spanned::span),
+            m.spacing.as_ref().map(Spanned::span),
+            m.padding.as_ref().map(Spanned::span),
+        ],
+        "`origin`, `size`, `cells`, `spacing` and `padding` apply to kind = \"grid\" meshes",
+    )?;
     if let Some(p) = m.patches.as_ref() {
         return Err(src.at(p, "`patches` applies to kind = \"simplex\" meshes (quadratic Gmsh elements are always split into their linear children)"));
     }
@@ -335,14 +329,15 @@ fn simplex_box<const D: usize>(
     variant: &Variant,
     src: &SceneSource,
 ) -> Result<BuiltMesh<D>, SceneError> {
-    let misplaced = [
-        m.file.as_ref().map(Spanned::span),
-        m.dimension.as_ref().map(Spanned::span),
-        m.padding.as_ref().map(Spanned::span),
-    ];
-    if let Some(span) = misplaced.into_iter().flatten().next() {
-        return Err(src.error(Some(span), "`file`, `dimension` and `padding` do not apply to kind = \"simplex\" meshes (a box of triangles or tetrahedra needs no padding)"));
-    }
+    refuse_first(
+        src,
+        [
+            m.file.as_ref().map(Spanned::span),
+            m.dimension.as_ref().map(Spanned::span),
+            m.padding.as_ref().map(Spanned::span),
+        ],
+        "`file`, `dimension` and `padding` do not apply to kind = \"simplex\" meshes (a box of triangles or tetrahedra needs no padding)",
+    )?;
     let (Some(origin), Some(size)) = (&m.origin, &m.size) else {
         return Err(src.error(
             None,
@@ -602,6 +597,19 @@ fn rectilinear<const D: usize>(
         let f = t - i as f64;
         row[i] + f * (row[i + 1] - row[i])
     })
+}
+
+/// Refuses the scene at the first of `spans` that is present (a key given
+/// where it does not apply) with `message`.
+fn refuse_first<const N: usize>(
+    src: &SceneSource,
+    spans: [Option<std::ops::Range<usize>>; N],
+    message: &str,
+) -> Result<(), SceneError> {
+    match spans.into_iter().flatten().next() {
+        Some(span) => Err(src.error(Some(span), message)),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
