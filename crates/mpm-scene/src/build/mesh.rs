@@ -147,17 +147,12 @@ fn annulus<const D: usize>(
     let check = Check { src };
     refuse_first(
         src,
-        [
-            m.origin.as_ref().map(Spanned::span),
-            m.size.as_ref().map(Spanned::span),
-            m.cells.as_ref().map(Spanned::span),
-            m.spacing.as_ref().map(Spanned::span),
-            m.padding.as_ref().map(Spanned::span),
+        grid_keys(m).into_iter().chain([
             m.file.as_ref().map(Spanned::span),
             m.dimension.as_ref().map(Spanned::span),
             m.patches.as_ref().map(Spanned::span),
             m.coordinates.as_ref().map(Spanned::span),
-        ],
+        ]),
         "an annulus mesh takes `inner_radius`, `outer_radius`, `layers`, `ring_nodes`, `jitter` and `seed`",
     )?;
     if D != 2 {
@@ -284,13 +279,7 @@ fn gmsh<const D: usize>(
 ) -> Result<BuiltMesh<D>, SceneError> {
     refuse_first(
         src,
-        [
-            m.origin.as_ref().map(Spanned::span),
-            m.size.as_ref().map(Spanned::span),
-            m.cells.as_ref().map(Spanned::span),
-            m.spacing.as_ref().map(Spanned::span),
-            m.padding.as_ref().map(Spanned::span),
-        ],
+        grid_keys(m),
         "`origin`, `size`, `cells`, `spacing` and `padding` apply to kind = \"grid\" meshes",
     )?;
     if let Some(p) = m.patches.as_ref() {
@@ -599,11 +588,23 @@ fn rectilinear<const D: usize>(
     })
 }
 
+/// The places of the keys of a regular grid (`origin`, `size`, `cells`,
+/// `spacing`, `padding`), in that order.
+fn grid_keys(m: &MeshSpec) -> [Option<std::ops::Range<usize>>; 5] {
+    [
+        m.origin.as_ref().map(Spanned::span),
+        m.size.as_ref().map(Spanned::span),
+        m.cells.as_ref().map(Spanned::span),
+        m.spacing.as_ref().map(Spanned::span),
+        m.padding.as_ref().map(Spanned::span),
+    ]
+}
+
 /// Refuses the scene at the first of `spans` that is present (a key given
 /// where it does not apply) with `message`.
-fn refuse_first<const N: usize>(
+fn refuse_first(
     src: &SceneSource,
-    spans: [Option<std::ops::Range<usize>>; N],
+    spans: impl IntoIterator<Item = Option<std::ops::Range<usize>>>,
     message: &str,
 ) -> Result<(), SceneError> {
     match spans.into_iter().flatten().next() {
