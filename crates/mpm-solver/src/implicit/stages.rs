@@ -16,6 +16,7 @@ use crate::error::{SolverError, StepFailure};
 use crate::formulation::Formulation;
 use crate::linear::LinearSolveError;
 use crate::locking::{LockingTreatment, PatchInput};
+use crate::mesh::MovableMesh;
 use crate::mesh::NodalMesh;
 use crate::parts::{PointsOf, SolverParts};
 use crate::stages::gather::PointStress;
@@ -272,6 +273,21 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         self.linear
             .analyse(sys.n_free, &sys.col_ptr, &sys.row_idx, symmetric)
             .map_err(SolverError::Pattern)?;
+        if self.linear.wants_rigid_body_modes() {
+            let mesh = &self.mesh;
+            let free: Vec<_> = (0..sys.n_active() * D)
+                .filter(|&dof| sys.free_of_dof[dof] != crate::stages::system::NONE)
+                .map(|dof| {
+                    (
+                        MovableMesh::node_position(mesh, sys.active[dof / D]),
+                        dof % D,
+                    )
+                })
+                .collect();
+            self.linear
+                .set_rigid_body_modes(&crate::linear::rigid_body_modes(&free))
+                .map_err(SolverError::Pattern)?;
+        }
         self.analysed = true;
         Ok(())
     }

@@ -13,6 +13,7 @@
 mod choice;
 mod faer_direct;
 mod faer_iterative;
+mod near_null;
 
 pub use choice::{
     AutoLinear, DEFAULT_MAX_DIRECT_DOFS_2D, DEFAULT_MAX_DIRECT_DOFS_3D, LinearChoice,
@@ -20,6 +21,7 @@ pub use choice::{
 };
 pub use faer_direct::FaerDirect;
 pub use faer_iterative::{FaerIterative, IterativeOptions};
+pub use near_null::rigid_body_modes;
 
 use thiserror::Error;
 
@@ -85,6 +87,14 @@ pub enum LinearSolveError {
         /// $\|b - Kx\|/\|b\|$ reached.
         relative_residual: f64,
     },
+    /// An external solver library (PETSc) failed; `message` is its own.
+    #[error("{library}: {message}")]
+    Backend {
+        /// The library.
+        library: &'static str,
+        /// What it reported.
+        message: String,
+    },
     /// The solution has a non-finite entry: the stiffness is singular or
     /// its values are not finite.
     #[error(
@@ -100,7 +110,10 @@ pub enum LinearSolveError {
 
 /// Checks a compressed-sparse-column pattern (the part of
 /// [`LinearSolver::analyse`] every implementation shares).
-pub(crate) fn check_pattern(
+///
+/// # Errors
+/// [`LinearSolveError::InvalidPattern`] saying what is wrong.
+pub fn check_pattern(
     n: usize,
     col_ptr: &[usize],
     row_idx: &[usize],
@@ -130,7 +143,10 @@ pub(crate) fn check_pattern(
 
 /// Checks the lengths handed to [`LinearSolver::solve`] against an
 /// analysed pattern of `nnz` entries and `n` rows.
-pub(crate) fn check_dimensions(
+///
+/// # Errors
+/// [`LinearSolveError::Dimension`] naming the wrong length.
+pub fn check_dimensions(
     nnz: usize,
     n: usize,
     values: &[f64],
@@ -190,5 +206,23 @@ pub trait LinearSolver: Send + std::fmt::Debug {
     /// direct one).
     fn last_iterations(&self) -> usize {
         0
+    }
+
+    /// Whether the solver uses the rigid-body modes of each step's free
+    /// dofs ([`LinearSolver::set_rigid_body_modes`]); the implicit solver
+    /// computes them only when asked. Default: no.
+    fn wants_rigid_body_modes(&self) -> bool {
+        false
+    }
+
+    /// The orthonormal rigid-body modes of the free dofs of the pattern
+    /// just analysed ([`rigid_body_modes`]), for a multigrid
+    /// preconditioner's near-null space. Default: ignored.
+    ///
+    /// # Errors
+    /// The solver could not use them.
+    fn set_rigid_body_modes(&mut self, modes: &[Vec<f64>]) -> Result<(), LinearSolveError> {
+        let _ = modes;
+        Ok(())
     }
 }
