@@ -189,6 +189,7 @@ where
             constraints: p.constraints.clone(),
             stepping: p.stepping,
             newton: p.newton,
+            petsc: p.petsc.clone(),
         };
         simulate_points::<D, B, F, U, K, SceneLaws, _>(
             points,

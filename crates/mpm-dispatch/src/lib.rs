@@ -14,6 +14,7 @@
 pub mod explicit;
 pub mod explicit_law;
 pub mod implicit;
+pub mod linear;
 pub mod run;
 
 pub use explicit::{

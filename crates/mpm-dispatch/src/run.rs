@@ -97,6 +97,11 @@ pub struct RunControl {
     pub checkpoint: bool,
     /// Continue from this checkpoint instead of starting at load factor 0.
     pub resume: Option<Checkpoint>,
+    /// Builds the linear solver a scene asks for beyond the built-in ones
+    /// (PETSc's, `linear = { petsc = "..." }`): set by a program built
+    /// with it (mpm-distributed's `petsc` feature); `None` refuses such a
+    /// scene.
+    pub external_linear: Option<crate::linear::ExternalLinear>,
     /// Attach each step's assembled stiffness to its [`Snapshot`] (for
     /// Matrix Market export).
     pub export_tangent: bool,
@@ -205,6 +210,9 @@ pub struct Analysis<M, L, C> {
     pub stepping: LoadStepping,
     /// Newton controls.
     pub newton: NewtonOptions,
+    /// PETSc's options when the linear solves go to PETSc
+    /// ([`crate::linear::external`]), `None` for `newton.linear`.
+    pub petsc: Option<mpm_scene::build::PetscRequest>,
 }
 
 /// Runs `setup` with basis `B`, formulation `F` and updater `U`; `observer`
@@ -249,6 +257,7 @@ where
         constraints: setup.constraints,
         stepping: setup.stepping,
         newton: setup.newton,
+        petsc: None,
     };
     let mut observer = observer;
     simulate_points::<D, B, F, U, NoLocking, L, C>(
@@ -285,6 +294,11 @@ where
 {
     let setup = analysis;
     let moves_mesh = setup.constraints.moves_mesh();
+    let external = crate::linear::external(
+        setup.petsc.as_ref(),
+        setup.newton.linear,
+        control.external_linear,
+    )?;
     let mut solver: ImplicitSolver<D, Parts<B, F, L, K, U, C>> = ImplicitSolver::new(
         basis,
         setup.grid,
@@ -294,6 +308,9 @@ where
         setup.constraints,
         setup.newton,
     );
+    if let Some(linear) = external {
+        solver.set_linear_solver(linear);
+    }
     let (state, earlier_time) = match &control.resume {
         Some(c) => {
             let resumed = MaterialPoints::from_flat(&c.points)?;

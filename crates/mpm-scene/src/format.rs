@@ -618,8 +618,9 @@ impl SolverSpec {
     }
 }
 
-/// `solver.linear`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+/// `solver.linear`: `"auto"`, `"direct"`, `"iterative"`, or
+/// `{ petsc = "-ksp_type cg -pc_type gamg" }`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum LinearKind {
     /// Direct up to `max_direct_dofs` free dofs, iterative beyond.
@@ -629,6 +630,10 @@ pub enum LinearKind {
     Direct,
     /// ILU(0)-preconditioned BiCGSTAB (faer, faer-precond).
     Iterative,
+    /// PETSc's Krylov method and preconditioner chosen by these options,
+    /// as on PETSc's command line (an `mpm` built with the `petsc`
+    /// feature).
+    Petsc(String),
 }
 
 /// `solver.first_tangent`.

@@ -329,6 +329,16 @@ pub struct TimedForces<const D: usize> {
     pub forces: Vec<(usize, SVector<f64, D>)>,
 }
 
+/// `linear = { petsc = "..." }`: PETSc's options, and the located
+/// refusal a program built without PETSc gives.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PetscRequest {
+    /// The options, as on PETSc's command line.
+    pub options: String,
+    /// `file:line:column: ...` at the `linear` key.
+    pub without_petsc: String,
+}
+
 /// A scene ready to run.
 #[derive(Debug, Clone)]
 pub struct Problem<const D: usize> {
@@ -370,6 +380,10 @@ pub struct Problem<const D: usize> {
     pub stepping: LoadStepping,
     /// Newton controls.
     pub newton: NewtonOptions,
+    /// `linear = { petsc = "..." }`: the implicit solver's linear solves
+    /// go to PETSc (in a program built with it) with
+    /// [`NewtonOptions::linear`]'s iterative tolerances.
+    pub petsc: Option<PetscRequest>,
     /// The variant.
     pub variant: Variant,
     /// The patch (parent element) of every element of a simplex mesh split
@@ -614,6 +628,7 @@ impl<const D: usize> Problem<D> {
         )?;
         let (stepping, newton) =
             solver::newton_and_stepping(s, src, matches!(mesh.mesh, SceneMesh::Grid(_)))?;
+        let petsc = solver::petsc_request(s, src)?;
         let (every, reactions, probes, fields) = outputs::outputs::<D>(
             &scene.output,
             explicit,
@@ -645,6 +660,7 @@ impl<const D: usize> Problem<D> {
             manufactured: loads.manufactured,
             stepping,
             newton,
+            petsc,
             variant,
             patch_of_element: mesh.patch_of_element,
             reactions,

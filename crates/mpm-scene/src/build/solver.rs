@@ -4,7 +4,7 @@
 
 use mpm_solver::{LoadStepping, NewtonOptions};
 
-use super::Check;
+use super::{Check, PetscRequest};
 use crate::SceneError;
 use crate::format::{LinearKind, SolverSpec};
 use crate::source::SceneSource;
@@ -113,9 +113,13 @@ pub(super) fn newton_and_stepping(
             }
             iterative.rel_tolerance = t;
         }
-        match *s.linear.get_ref() {
+        match s.linear.get_ref() {
             LinearKind::Direct => mpm_solver::LinearChoice::Direct,
-            LinearKind::Iterative => mpm_solver::LinearChoice::Iterative(iterative),
+            // PETSc's solver replaces the iterative one at run time
+            // (mpm-dispatch) and takes its tolerances.
+            LinearKind::Iterative | LinearKind::Petsc(_) => {
+                mpm_solver::LinearChoice::Iterative(iterative)
+            }
             LinearKind::Auto => mpm_solver::LinearChoice::Auto {
                 max_direct_dofs: s.max_direct_dofs.as_ref().map(|m| *m.get_ref()),
                 iterative,
@@ -127,7 +131,7 @@ pub(super) fn newton_and_stepping(
     {
         return Err(src.at(
             t,
-            "solver `linear_tolerance` applies to the iterative solver (`linear = \"iterative\"` or `\"auto\"`) only",
+            "solver `linear_tolerance` applies to the iterative solvers (`linear = \"iterative\"`, `\"auto\"` or `{ petsc = ... }`) only",
         ));
     }
     if let Some(m) = &s.max_direct_dofs
@@ -152,6 +156,36 @@ pub(super) fn newton_and_stepping(
             ..NewtonOptions::default()
         },
     ))
+}
+
+/// The PETSc request of `linear = { petsc = "..." }`, `None` for the
+/// built-in solvers. PETSc itself checks the options when the solver is
+/// built (an unknown method, an option no object reads); a program built
+/// without PETSc refuses the request with the message located here.
+///
+/// # Errors
+/// [`SceneError::Scene`] at `linear` when the options hold a NUL byte.
+pub(super) fn petsc_request(
+    s: &SolverSpec,
+    src: &SceneSource,
+) -> Result<Option<PetscRequest>, SceneError> {
+    let LinearKind::Petsc(options) = s.linear.get_ref() else {
+        return Ok(None);
+    };
+    if options.contains('\0') {
+        return Err(src.at(
+            &s.linear,
+            "solver `linear`: PETSc options may not hold a NUL byte",
+        ));
+    }
+    let without = src.at(
+        &s.linear,
+        "solver `linear = { petsc = ... }` needs an mpm built with PETSc: `cargo build --release -p mpm-cases --features petsc` (README, \"Distributed runs\")",
+    );
+    Ok(Some(PetscRequest {
+        options: options.clone(),
+        without_petsc: without.to_string(),
+    }))
 }
 
 /// The ghost penalty of `s` (off unless `ghost_penalty` is given); `grid`:
