@@ -90,6 +90,7 @@ impl Session {
         let control = RunControl {
             checkpoint: true,
             resume,
+            external_linear: mpm_distributed::external_linear(),
             export_tangent: self.export_tangent,
         };
         let mut observer = Observer::new(writer, self.case.clone(), parameters);

@@ -1,0 +1,230 @@
+//! [`PetscLinear`]: the implicit solver's linear solve through PETSc.
+//!
+//! Per load step ([`LinearSolver::analyse`]) the free-dof pattern becomes
+//! a COO preallocation of a parallel AIJ matrix (`MatSetPreallocationCOO`)
+//! and a KSP is configured from the options string; per Newton iteration
+//! ([`LinearSolver::solve`]) the values are set in the pattern's own order
+//! (`MatSetValuesCOO`, no copy or sort), the preconditioner is rebuilt for
+//! them and the system solved. When the options choose GAMG, the rigid-body
+//! modes of the free dofs are its near-null space.
+//!
+//! Options no PETSc object read after the first solve are an error
+//! ([`PetscError::Unused`]): a misspelt `-pc_type` must not silently run
+//! another method. A solve that does not converge is
+//! [`LinearSolveError::NotConverged`] when it reached its iteration limit,
+//! as for the built-in iterative solver, so Newton cuts the step the same
+//! way; another divergence (a breakdown, an indefinite preconditioner) is
+//! [`LinearSolveError::Backend`] with PETSc's reason.
+
+use mpm_solver::linear::{check_dimensions, check_pattern};
+use mpm_solver::{Factorisation, IterativeOptions, LinearSolveError, LinearSolver};
+
+use crate::PetscError;
+use crate::raw::{self, Int, Krylov, Matrix, Options, Vector};
+
+/// PETSc's `KSP_DIVERGED_ITS`: the iteration limit reached.
+const DIVERGED_ITS: i32 = -3;
+
+/// A PETSc KSP as the implicit solver's [`LinearSolver`] (module docs).
+pub struct PetscLinear {
+    options: String,
+    tolerances: IterativeOptions,
+    step: Option<Step>,
+    modes: Vec<Vec<f64>>,
+    checked_options: bool,
+    last: Option<Factorisation>,
+    iterations: usize,
+}
+
+/// What one load step's pattern holds.
+struct Step {
+    n: usize,
+    nnz: usize,
+    matrix: Matrix,
+    ksp: Krylov,
+    options: Options,
+    b: Vector,
+    x: Vector,
+}
+
+impl std::fmt::Debug for PetscLinear {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PetscLinear")
+            .field("options", &self.options)
+            .field("tolerances", &self.tolerances)
+            .field("analysed", &self.step.as_ref().map(|s| (s.n, s.nnz)))
+            .finish_non_exhaustive()
+    }
+}
+
+impl PetscLinear {
+    /// A solver configured by PETSc's `options` (e.g.
+    /// `-ksp_type cg -pc_type gamg`; empty: PETSc's defaults, GMRES with
+    /// ILU(0) on one rank), with `tolerances` (relative residual and
+    /// iteration limit) unless the options set `-ksp_rtol` / `-ksp_max_it`.
+    pub fn new(options: &str, tolerances: IterativeOptions) -> Self {
+        Self {
+            options: options.to_owned(),
+            tolerances,
+            step: None,
+            modes: Vec::new(),
+            checked_options: false,
+            last: None,
+            iterations: 0,
+        }
+    }
+
+    /// The Krylov method's and the preconditioner's names of the analysed
+    /// step (`("cg", "gamg")`), as PETSc resolved the options.
+    ///
+    /// # Errors
+    /// No step analysed, or PETSc failed.
+    pub fn methods(&self) -> Result<(String, String), LinearSolveError> {
+        let step = self.step.as_ref().ok_or(LinearSolveError::NotAnalysed)?;
+        let s = raw::lock()?;
+        Ok(step.ksp.names(&s)?)
+    }
+
+    fn uses_gamg(&self) -> bool {
+        self.options
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .windows(2)
+            .any(|w| w[0] == "-pc_type" && w[1] == "gamg")
+    }
+
+    /// The pattern's COO pairs (CSC order, so values need no reordering).
+    fn coo(
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+    ) -> Result<(Vec<Int>, Vec<Int>), PetscError> {
+        let index = |i: usize| Int::try_from(i).map_err(|_| PetscError::Size);
+        let mut rows = Vec::with_capacity(row_idx.len());
+        let mut cols = Vec::with_capacity(row_idx.len());
+        for c in 0..n {
+            let col = index(c)?;
+            for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
+                rows.push(index(r)?);
+                cols.push(col);
+            }
+        }
+        Ok((rows, cols))
+    }
+
+    fn build_step(
+        &self,
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        symmetric: bool,
+    ) -> Result<Step, PetscError> {
+        let (mut rows, mut cols) = Self::coo(n, col_ptr, row_idx)?;
+        let size = Int::try_from(n).map_err(|_| PetscError::Size)?;
+        let max_it = Int::try_from(self.tolerances.max_iterations).unwrap_or(Int::MAX);
+        let s = raw::lock()?;
+        let matrix = Matrix::coo(&s, size, size, &mut rows, &mut cols, symmetric)?;
+        let options = Options::new(&s, &self.options)?;
+        let ksp = Krylov::new(&s, &matrix, &options, self.tolerances.rel_tolerance, max_it)?;
+        let b = matrix.vector(&s)?;
+        let x = matrix.vector(&s)?;
+        Ok(Step {
+            n,
+            nnz: row_idx.len(),
+            matrix,
+            ksp,
+            options,
+            b,
+            x,
+        })
+    }
+}
+
+impl LinearSolver for PetscLinear {
+    fn analyse(
+        &mut self,
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        symmetric: bool,
+    ) -> Result<(), LinearSolveError> {
+        self.step = None;
+        self.modes.clear();
+        check_pattern(n, col_ptr, row_idx)?;
+        self.step = Some(self.build_step(n, col_ptr, row_idx, symmetric)?);
+        Ok(())
+    }
+
+    fn solve(
+        &mut self,
+        values: &[f64],
+        rhs: &mut [f64],
+    ) -> Result<Factorisation, LinearSolveError> {
+        self.last = None;
+        let step = self.step.as_mut().ok_or(LinearSolveError::NotAnalysed)?;
+        check_dimensions(step.nnz, step.n, values, rhs)?;
+        let b_norm = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let s = raw::lock()?;
+        step.matrix.set_values(&s, values)?;
+        if !self.modes.is_empty() {
+            step.matrix.set_near_null_space(&s, &self.modes)?;
+            self.modes.clear();
+        }
+        step.b.write(&s, rhs)?;
+        let outcome = step.ksp.solve(&s, &step.b, &mut step.x)?;
+        if !self.checked_options {
+            let unused = step.options.unused(&s)?;
+            if !unused.is_empty() {
+                return Err(PetscError::Unused(unused.join(", ")).into());
+            }
+            self.checked_options = true;
+        }
+        self.iterations = outcome.iterations;
+        if outcome.reason == DIVERGED_ITS {
+            return Err(LinearSolveError::NotConverged {
+                iterations: outcome.iterations,
+                relative_residual: outcome.residual_norm / b_norm.max(f64::MIN_POSITIVE),
+            });
+        }
+        if outcome.reason < 0 {
+            let reason = step.ksp.reason_name(&s)?;
+            return Err(LinearSolveError::Backend {
+                library: "PETSc",
+                message: format!(
+                    "KSP did not converge ({reason}) in {} iterations, residual norm {:.3e} against |b| = {b_norm:.3e}",
+                    outcome.iterations, outcome.residual_norm
+                ),
+            });
+        }
+        step.x.read(&s, rhs)?;
+        if let Some(dof) = rhs.iter().position(|v| !v.is_finite()) {
+            return Err(LinearSolveError::NonFinite {
+                factorisation: Factorisation::Iterative,
+                dof,
+            });
+        }
+        self.last = Some(Factorisation::Iterative);
+        Ok(Factorisation::Iterative)
+    }
+
+    fn last_factorisation(&self) -> Option<Factorisation> {
+        self.last
+    }
+
+    fn nnz(&self) -> usize {
+        self.step.as_ref().map_or(0, |s| s.nnz)
+    }
+
+    fn last_iterations(&self) -> usize {
+        self.iterations
+    }
+
+    fn wants_rigid_body_modes(&self) -> bool {
+        self.uses_gamg()
+    }
+
+    fn set_rigid_body_modes(&mut self, modes: &[Vec<f64>]) -> Result<(), LinearSolveError> {
+        self.modes = modes.to_vec();
+        Ok(())
+    }
+}
