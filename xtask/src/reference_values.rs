@@ -33,6 +33,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow};
+use mpm_cases::cases::Solve;
 use mpm_cases::cases::annulus::{self, AnnulusParams};
 use mpm_cases::cases::cantilever::{self, CantileverParams, elastica_tip};
 use mpm_cases::cases::collapse::{self, CollapseParams};
@@ -344,8 +345,9 @@ fn column_file(_: &Path, time: &mut f64) -> Result<CaseRuns> {
                 v
             );
             let name = format!("{}, k = {k}", variant_name(&v));
-            let r = column::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
-                .with_context(|| name.clone())?;
+            let r =
+                column::ColumnCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
+                    .with_context(|| name.clone())?;
             let values = BTreeMap::from([("error", r.error)]);
             *time += r.output.wall_time_s;
             log("column", &name, r.output.wall_time_s, &values);
@@ -407,7 +409,10 @@ fn cantilever_file(_: &Path, time: &mut f64) -> Result<CaseRuns> {
             v
         );
         let name = format!("{}, {ppc}x{ppc} points, h = {h}", variant_name(&v));
-        let r = cantilever::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
+        let r =
+            cantilever::CantileverCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| {
+                Ok(())
+            })
             .with_context(|| name.clone())?;
         let &(_, u, w) = r
             .tip
@@ -518,8 +523,9 @@ fn collapse_file(_: &Path, time: &mut f64) -> Result<CaseRuns> {
             v
         );
         let name = format!("{}, {ppc}x{ppc} points, h = {}", variant_name(&v), p.h);
-        let r = collapse::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
-            .with_context(|| name.clone())?;
+        let r =
+            collapse::CollapseCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
+                .with_context(|| name.clone())?;
         let values = BTreeMap::from([
             ("horizontal_extent", r.horizontal_extent),
             ("max_height", r.max_height),
@@ -611,8 +617,9 @@ fn annulus_file(workspace: &Path, time: &mut f64) -> Result<CaseRuns> {
             variant_name(&v),
             relative.display()
         );
-        let r = annulus::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
-            .with_context(|| name.clone())?;
+        let r =
+            annulus::AnnulusCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
+                .with_context(|| name.clone())?;
         let values = BTreeMap::from([
             ("error", r.error),
             ("max_error", r.max_error),
@@ -715,8 +722,9 @@ fn stretch_file(workspace: &Path, time: &mut f64) -> Result<CaseRuns> {
             p.yield_stress,
             if p.predictor { "" } else { ", no predictor" }
         );
-        let r = stretch::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
-            .with_context(|| name.clone())?;
+        let r =
+            stretch::StretchCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
+                .with_context(|| name.clone())?;
         let values = BTreeMap::from([
             ("error", r.error),
             ("analytic_stress", r.analytic_stress),

@@ -12,7 +12,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Result;
-use mpm_cases::cases::stretch::{StretchParams, StretchResult, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::stretch::{StretchCase, StretchParams, StretchResult};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{LockingKind, Variant};
 use mpm_mesh::{BoxMesh, SimplexMesh, SplitMix64};
@@ -169,8 +170,8 @@ fn stretch_rows(full: bool, paper_yield: f64) -> StretchRows {
             ..p.clone()
         };
         let [patched, standard] = [&fpatch, &Variant::default()].map(|v| {
-            let on_branch = run(&p, v, &RunControl::default(), |_, _, _| Ok(()));
-            let necked = run(&necked_p, v, &RunControl::default(), |_, _, _| Ok(()));
+            let on_branch = StretchCase::run(&p, v, &RunControl::default(), |_, _, _| Ok(()));
+            let necked = StretchCase::run(&necked_p, v, &RunControl::default(), |_, _, _| Ok(()));
             (on_branch, necked)
         });
         let mut row = vec![cells.to_string()];

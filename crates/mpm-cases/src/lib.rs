@@ -13,12 +13,13 @@
 //! atomically; [`checkpoint`] resumes an interrupted run.
 //!
 //! ```
-//! use mpm_cases::cases::column::{self, ColumnParams};
+//! use mpm_cases::cases::Solve;
+//! use mpm_cases::cases::column::{ColumnCase, ColumnParams};
 //! use mpm_cases::run::RunControl;
 //! use mpm_cases::variant::Variant;
 //!
 //! let params = ColumnParams { h: 12.5, ..ColumnParams::default() };
-//! let result = column::run(&params, &Variant::default(), &RunControl::default(), |_, _, _| Ok(()))?;
+//! let result = ColumnCase::run(&params, &Variant::default(), &RunControl::default(), |_, _, _| Ok(()))?;
 //! assert!(result.error < 0.1, "eq. (42) error {}", result.error);
 //! # Ok::<(), mpm_solver::SolverError>(())
 //! ```

@@ -59,5 +59,18 @@ macro_rules! case_params {
                 }
             }
         }
+
+        impl $crate::params::CaseParams for $name {
+            fn variant(&self) -> $crate::variant::Variant {
+                $name::variant(self)
+            }
+        }
     };
+}
+
+/// What every [`case_params!`] struct offers a generic caller (e.g.
+/// [`crate::cases::Solve`]).
+pub trait CaseParams {
+    /// The MPM variant these parameters name.
+    fn variant(&self) -> crate::variant::Variant;
 }

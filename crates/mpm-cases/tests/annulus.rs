@@ -6,7 +6,8 @@
 
 use std::path::PathBuf;
 
-use mpm_cases::cases::annulus::{AnnulusParams, Torsion, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::annulus::{AnnulusCase, AnnulusParams, Torsion};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{FormulationKind, Variant};
 use mpm_constitutive::tensor::embed;
@@ -106,7 +107,7 @@ fn error(i: usize, points_per_element: usize) -> (f64, f64) {
         points_per_element,
         ..AnnulusParams::default()
     };
-    let r = run(
+    let r = AnnulusCase::run(
         &p,
         &Variant::default(),
         &RunControl::default(),
@@ -154,7 +155,7 @@ fn updated_lagrangian_equals_previously_converged_on_triangles() {
             formulation,
             ..Variant::default()
         };
-        run(&p, &v, &RunControl::default(), |_, _, _| Ok(())).unwrap()
+        AnnulusCase::run(&p, &v, &RunControl::default(), |_, _, _| Ok(())).unwrap()
     };
     let (pc, ul) = (go(FormulationKind::Pc), go(FormulationKind::Ul));
     let worst = pc
@@ -175,7 +176,7 @@ fn the_simplex_cases_refuse_grid_only_variants() {
         basis: BasisKind::Gimp,
         ..Variant::default()
     };
-    let e = run(
+    let e = AnnulusCase::run(
         &AnnulusParams::default(),
         &v,
         &RunControl::default(),

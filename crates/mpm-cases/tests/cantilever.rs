@@ -3,7 +3,8 @@
 #![allow(clippy::unwrap_used)]
 
 use mpm_basis::LinearMpm;
-use mpm_cases::cases::cantilever::{CantileverParams, problem, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::cantilever::{CantileverCase, CantileverParams};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{FormulationKind, Variant};
 use mpm_constitutive::HenckyElastic;
@@ -17,8 +18,8 @@ use nalgebra::SVector;
 fn cantilever_converges_quadratically_and_ul_equals_pc() {
     let p = CantileverParams::default();
     let control = RunControl::default();
-    let pc = run(&p, &Variant::default(), &control, |_, _, _| Ok(())).unwrap();
-    let ul = run(
+    let pc = CantileverCase::run(&p, &Variant::default(), &control, |_, _, _| Ok(())).unwrap();
+    let ul = CantileverCase::run(
         &p,
         &Variant {
             formulation: FormulationKind::Ul,
@@ -98,7 +99,7 @@ fn the_pc_solution_satisfies_ul_equilibrium_at_every_step() {
         ..CantileverParams::default()
     };
     // The case's own scene: its grid, points, conditions and loaded points.
-    let (built, loaded) = problem(&p, &p.variant()).unwrap();
+    let (built, loaded) = CantileverCase::build(&p, &p.variant()).unwrap();
     let mpm_cases::scene::build::SceneMesh::Grid(grid) = built.mesh.clone() else {
         panic!("the cantilever runs on a grid")
     };

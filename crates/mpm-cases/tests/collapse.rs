@@ -1,7 +1,8 @@
 //! Elasto-plastic collapse (Coombs 2020 §7.5) against Table 6.
 #![allow(clippy::unwrap_used)]
 
-use mpm_cases::cases::collapse::{CollapseParams, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::collapse::{CollapseCase, CollapseParams};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::Variant;
 
@@ -17,7 +18,7 @@ fn standard_mpm_collapse_reproduces_table_6_within_one_percent() {
             points_per_cell: ppc,
             ..CollapseParams::default()
         };
-        let r = run(
+        let r = CollapseCase::run(
             &p,
             &Variant::default(),
             &RunControl::default(),

@@ -1,7 +1,8 @@
 //! Compaction under self weight (Coombs 2020 §7.1, eqs. 41–42).
 #![allow(clippy::unwrap_used)]
 
-use mpm_cases::cases::column::{ColumnParams, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::column::{ColumnCase, ColumnParams};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{BasisKind, DomainUpdateKind, FormulationKind};
 
@@ -31,11 +32,11 @@ fn updated_lagrangian_equals_previously_converged() {
     ] {
         let pc_p = params(4, basis, FormulationKind::Pc, update);
         let ul_p = params(4, basis, FormulationKind::Ul, update);
-        let pc = run(&pc_p, &pc_p.variant(), &RunControl::default(), |_, _, _| {
+        let pc = ColumnCase::run(&pc_p, &pc_p.variant(), &RunControl::default(), |_, _, _| {
             Ok(())
         })
         .unwrap();
-        let ul = run(&ul_p, &ul_p.variant(), &RunControl::default(), |_, _, _| {
+        let ul = ColumnCase::run(&ul_p, &ul_p.variant(), &RunControl::default(), |_, _, _| {
             Ok(())
         })
         .unwrap();
@@ -87,7 +88,8 @@ fn gimp_converges_with_grid_refinement_and_standard_mpm_stagnates() {
             FormulationKind::Pc,
             DomainUpdateKind::Stretch,
         );
-        let r = run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap();
+        let r =
+            ColumnCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap();
         println!(
             "gimp k={k}: error {:.4e}, {} iterations",
             r.error, r.output.summary.iterations
@@ -117,7 +119,7 @@ fn gimp_converges_with_grid_refinement_and_standard_mpm_stagnates() {
         DomainUpdateKind::None,
     );
     let (c, f) = (
-        run(
+        ColumnCase::run(
             &coarse,
             &coarse.variant(),
             &RunControl::default(),
@@ -125,7 +127,7 @@ fn gimp_converges_with_grid_refinement_and_standard_mpm_stagnates() {
         )
         .unwrap()
         .error,
-        run(&fine, &fine.variant(), &RunControl::default(), |_, _, _| {
+        ColumnCase::run(&fine, &fine.variant(), &RunControl::default(), |_, _, _| {
             Ok(())
         })
         .unwrap()
@@ -141,7 +143,8 @@ fn bad_grid_size_is_a_clear_error() {
         h: 3.0,
         ..ColumnParams::default()
     };
-    let err = run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap_err();
+    let err =
+        ColumnCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap_err();
     assert!(
         err.to_string().contains("must divide the column height"),
         "{err}"
@@ -151,7 +154,8 @@ fn bad_grid_size_is_a_clear_error() {
         domain_update: DomainUpdateKind::Stretch,
         ..ColumnParams::default()
     };
-    let err = run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap_err();
+    let err =
+        ColumnCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(())).unwrap_err();
     assert!(err.to_string().contains("needs basis = gimp"), "{err}");
 }
 
@@ -175,7 +179,7 @@ fn the_column_scene_runs_with_fbar() {
             locking,
             ..p.variant()
         };
-        let r = run(&p, &v, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+        let r = ColumnCase::run(&p, &v, &RunControl::default(), |_, _, _| Ok(())).unwrap();
         println!("{formulation} {locking}: error {:.4e}", r.error);
         errors.push(r.error);
         last.push(r.output.last.position.clone());

@@ -7,6 +7,7 @@
 //! studies as tables and plots into `docs/src/reproduction/`.
 #![allow(clippy::unwrap_used)]
 
+use mpm_cases::cases::Solve;
 use mpm_cases::cases::cantilever::{self, CantileverParams, elastica_tip};
 use mpm_cases::cases::collapse::{self, CollapseParams};
 use mpm_cases::cases::column::{self, ColumnParams};
@@ -45,7 +46,7 @@ fn column_errors(v: &Variant, ks: std::ops::RangeInclusive<i32>) -> Vec<f64> {
             h: 50.0 / 2f64.powi(k),
             ..ColumnParams::default()
         };
-        column::run(&p, v, &RunControl::default(), |_, _, _| Ok(()))
+        column::ColumnCase::run(&p, v, &RunControl::default(), |_, _, _| Ok(()))
             .unwrap()
             .error
     })
@@ -144,7 +145,8 @@ fn table7_collapse_extent_and_height_per_domain_rule() {
         ..CollapseParams::default()
     };
     let run = |v: &Variant| {
-        let r = collapse::run(&p, v, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+        let r =
+            collapse::CollapseCase::run(&p, v, &RunControl::default(), |_, _, _| Ok(())).unwrap();
         assert_eq!(r.output.reports.len(), 40, "{v:?}: no step cut");
         println!(
             "{:>36} ({}): extent {:.4} height {:.4}",
@@ -192,7 +194,7 @@ fn table8_gimp_collapse_converges_quadratically() {
         points_per_cell: 6,
         ..CollapseParams::default()
     };
-    let r = collapse::run(
+    let r = collapse::CollapseCase::run(
         &p,
         &gimp(DomainUpdateKind::CornerMidpoint),
         &RunControl::default(),
@@ -274,7 +276,8 @@ fn cantilever_with_gimp_and_cpdi2_follows_the_elastica() {
                 formulation: f,
                 ..v
             };
-            cantilever::run(&p, &v, &RunControl::default(), |_, _, _| Ok(())).unwrap()
+            cantilever::CantileverCase::run(&p, &v, &RunControl::default(), |_, _, _| Ok(()))
+                .unwrap()
         };
         let (pc, ul) = (go(FormulationKind::Pc), go(FormulationKind::Ul));
         assert_eq!(pc.output.reports.len(), 50, "{v:?}");
@@ -304,7 +307,7 @@ fn cantilever_with_gimp_and_cpdi2_follows_the_elastica() {
         points_per_cell: 6,
         ..CantileverParams::default()
     };
-    let fine = cantilever::run(
+    let fine = cantilever::CantileverCase::run(
         &p,
         &gimp(DomainUpdateKind::CornerMidpoint),
         &RunControl::default(),

@@ -42,6 +42,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use mpm_cases::cases::Solve;
 use mpm_cases::cases::annulus::{self, AnnulusParams};
 use mpm_cases::cases::cantilever::{self, CantileverParams};
 use mpm_cases::cases::collapse::{self, CollapseParams};
@@ -343,8 +344,9 @@ fn column_errors_per_variant_and_level() {
         "column",
         |settings| {
             let p: ColumnParams = params(settings)?;
-            let r = column::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
-                .map_err(|e| e.to_string())?;
+            let r =
+                column::ColumnCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
+                    .map_err(|e| e.to_string())?;
             Ok(Measured::of(
                 &r.output,
                 r.material_points,
@@ -361,8 +363,13 @@ fn cantilever_tip_and_table3_residuals() {
         "cantilever",
         |settings| {
             let p: CantileverParams = params(settings)?;
-            let r = cantilever::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
-                .map_err(|e| e.to_string())?;
+            let r = cantilever::CantileverCase::run(
+                &p,
+                &p.variant(),
+                &RunControl::default(),
+                |_, _, _| Ok(()),
+            )
+            .map_err(|e| e.to_string())?;
             let &(_, u, v) = r.tip.last().ok_or("no load step")?;
             Ok(Measured::of(
                 &r.output,
@@ -380,7 +387,10 @@ fn collapse_tables_6_7_8() {
         "collapse",
         |settings| {
             let p: CollapseParams = params(settings)?;
-            let r = collapse::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
+            let r =
+                collapse::CollapseCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| {
+                    Ok(())
+                })
                 .map_err(|e| e.to_string())?;
             Ok(Measured::of(
                 &r.output,
@@ -402,7 +412,10 @@ fn annulus_errors_on_the_committed_meshes() {
         |settings| {
             let mut p: AnnulusParams = params(settings)?;
             resolve(&mut p.mesh);
-            let r = annulus::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
+            let r =
+                annulus::AnnulusCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| {
+                    Ok(())
+                })
                 .map_err(|e| e.to_string())?;
             let mut m = Measured::of(
                 &r.output,
@@ -427,7 +440,10 @@ fn stretch_table1_errors() {
         |settings| {
             let mut p: StretchParams = params(settings)?;
             resolve(&mut p.mesh);
-            let r = stretch::run(&p, &p.variant(), &RunControl::default(), |_, _, _| Ok(()))
+            let r =
+                stretch::StretchCase::run(&p, &p.variant(), &RunControl::default(), |_, _, _| {
+                    Ok(())
+                })
                 .map_err(|e| e.to_string())?;
             let mut m = Measured::of(
                 &r.output,

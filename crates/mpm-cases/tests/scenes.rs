@@ -842,6 +842,7 @@ proptest! {
 /// (42) is then the same number.
 #[test]
 fn column_scene_equals_the_column_case() {
+    use mpm_cases::cases::Solve;
     use mpm_cases::cases::column::{self, ColumnParams};
     use mpm_cases::variant::{BasisKind, DomainUpdateKind, FormulationKind};
     let text = include_str!("../../../scenes/coombs2020_column.toml");
@@ -869,7 +870,7 @@ fn column_scene_equals_the_column_case() {
             formulation,
             ..ColumnParams::default()
         };
-        let case = column::run(
+        let case = column::ColumnCase::run(
             &params,
             &params.variant(),
             &RunControl::default(),
@@ -883,7 +884,7 @@ fn column_scene_equals_the_column_case() {
         ];
         let set: Vec<&str> = set.iter().map(String::as_str).collect();
         let (problem, out) = run2(text, &set);
-        let built = column::problem(&params, &params.variant()).unwrap();
+        let built = column::ColumnCase::build(&params, &params.variant()).unwrap();
         assert_eq!(problem.position, built.position, "{basis}");
         assert_eq!(
             out.last.sigma, case.output.last.sigma,
@@ -1019,10 +1020,11 @@ fn every_documented_key_is_exercised() {
 /// Table 6 figures.
 #[test]
 fn collapse_scene_equals_the_collapse_case() {
+    use mpm_cases::cases::Solve;
     use mpm_cases::cases::collapse::{self, CollapseParams};
     let text = include_str!("../../../scenes/coombs2020_collapse.toml");
     let params = CollapseParams::default();
-    let case = collapse::run(
+    let case = collapse::CollapseCase::run(
         &params,
         &params.variant(),
         &RunControl::default(),
@@ -1030,7 +1032,7 @@ fn collapse_scene_equals_the_collapse_case() {
     )
     .unwrap();
     let (problem, out) = run2(text, &[]);
-    let built = collapse::problem(&params, &params.variant()).unwrap();
+    let built = collapse::CollapseCase::build(&params, &params.variant()).unwrap();
     assert_eq!(problem.position, built.position);
     assert_same_final_state(&out, &case.output);
     // Table 6 (h = 1 m, 3² points per cell): extent and height at the edge
@@ -1058,10 +1060,11 @@ fn collapse_scene_equals_the_collapse_case() {
 /// file: the same loaded points and the same final state bit for bit.
 #[test]
 fn cantilever_scene_equals_the_cantilever_case() {
+    use mpm_cases::cases::Solve;
     use mpm_cases::cases::cantilever::{self, CantileverParams};
     let text = include_str!("../../../scenes/coombs2020_cantilever.toml");
     let params = CantileverParams::default();
-    let case = cantilever::run(
+    let case = cantilever::CantileverCase::run(
         &params,
         &params.variant(),
         &RunControl::default(),
@@ -1069,7 +1072,7 @@ fn cantilever_scene_equals_the_cantilever_case() {
     )
     .unwrap();
     let (problem, out) = run2(text, &[]);
-    let (built, loaded) = cantilever::problem(&params, &params.variant()).unwrap();
+    let (built, loaded) = cantilever::CantileverCase::build(&params, &params.variant()).unwrap();
     assert_eq!(problem.position, built.position);
     let forces: Vec<usize> = problem.point_forces.iter().map(|(p, _)| *p).collect();
     assert_eq!(forces, loaded.to_vec());
@@ -1085,10 +1088,11 @@ fn cantilever_scene_equals_the_cantilever_case() {
 /// same final state bit for bit, and the homogeneous closed-form stress.
 #[test]
 fn shear_scene_equals_the_shear_case() {
+    use mpm_cases::cases::Solve;
     use mpm_cases::cases::shear::{self, ShearParams};
     let text = include_str!("../../../scenes/coombs2020_shear.toml");
     let params = ShearParams::default();
-    let case = shear::run(
+    let case = shear::ShearCase::run(
         &params,
         &params.variant(),
         &RunControl::default(),
@@ -1115,10 +1119,11 @@ fn shear_scene_equals_the_shear_case() {
 /// points and the same final state bit for bit.
 #[test]
 fn stretch_scene_equals_the_stretch_case() {
+    use mpm_cases::cases::Solve;
     use mpm_cases::cases::stretch::{self, StretchParams};
     let text = include_str!("../../../scenes/wang2021_stretch.toml");
     let params = StretchParams::default();
-    let case = stretch::run(
+    let case = stretch::StretchCase::run(
         &params,
         &params.variant(),
         &RunControl::default(),
@@ -1319,10 +1324,11 @@ fn footing_steps_stalled_at_the_rounding_floor_are_accepted() {
 /// of `scenes/annulus_gmsh.toml` is that scene with the Gmsh mesh.
 #[test]
 fn annulus_scene_equals_the_annulus_case() {
+    use mpm_cases::cases::Solve;
     use mpm_cases::cases::annulus::{self, AnnulusParams};
     let scenes = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes"));
     let params = AnnulusParams::default();
-    let case = annulus::run(
+    let case = annulus::AnnulusCase::run(
         &params,
         &params.variant(),
         &RunControl::default(),
@@ -1356,10 +1362,11 @@ fn annulus_scene_equals_the_annulus_case() {
         mesh: Some(scenes.join("meshes/annulus_2.msh")),
         ..AnnulusParams::default()
     };
-    let on_gmsh = annulus::run(&gmsh, &gmsh.variant(), &RunControl::default(), |_, _, _| {
-        Ok(())
-    })
-    .unwrap();
+    let on_gmsh =
+        annulus::AnnulusCase::run(&gmsh, &gmsh.variant(), &RunControl::default(), |_, _, _| {
+            Ok(())
+        })
+        .unwrap();
     let gmsh_text = text.replace(
         "kind = \"annulus\"\ninner_radius = 0.75\nouter_radius = 1.25\nlayers = 4\nring_nodes = 63\njitter = 0.0\nseed = 1",
         "kind = \"gmsh\"\nfile = \"meshes/annulus_2.msh\"\ndimension = 2",

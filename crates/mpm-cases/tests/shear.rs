@@ -2,7 +2,8 @@
 //! the single-point reference to 1e-6.
 #![allow(clippy::unwrap_used)]
 
-use mpm_cases::cases::shear::{ShearParams, SinglePoint, elastic_closed_form, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::shear::{ShearCase, ShearParams, SinglePoint, elastic_closed_form};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{BasisKind, DomainUpdateKind, FormulationKind, Variant};
 use mpm_constitutive::HenckyElastic;
@@ -44,7 +45,7 @@ fn simple_shear_is_homogeneous_and_matches_the_reference() {
                     domain_update,
                     ..Variant::default()
                 };
-                let r = run(&p, &v, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+                let r = ShearCase::run(&p, &v, &RunControl::default(), |_, _, _| Ok(())).unwrap();
                 println!(
                     "{basis} {formulation} yield {yield_stress:?}: max relative stress error {:.2e}, {} iterations",
                     r.error, r.output.summary.iterations

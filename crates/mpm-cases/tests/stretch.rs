@@ -4,12 +4,13 @@
 
 use std::path::PathBuf;
 
-use mpm_cases::cases::stretch::{StretchParams, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::stretch::{StretchCase, StretchParams};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{FormulationKind, Variant};
 
 fn go(p: &StretchParams) -> mpm_cases::cases::stretch::StretchResult {
-    run(p, &Variant::default(), &RunControl::default(), |_, _, _| {
+    StretchCase::run(p, &Variant::default(), &RunControl::default(), |_, _, _| {
         Ok(())
     })
     .unwrap()
@@ -75,7 +76,7 @@ fn without_the_predictor_newton_stays_on_the_homogeneous_branch() {
 fn updated_lagrangian_equals_previously_converged_on_tetrahedra() {
     let p = StretchParams::default();
     let pc = go(&p);
-    let ul = run(
+    let ul = StretchCase::run(
         &p,
         &Variant {
             formulation: FormulationKind::Ul,
@@ -134,7 +135,7 @@ fn fpatch_runs_the_stretch_from_its_scene() {
             predictor,
             ..StretchParams::default()
         };
-        let r = run(&p, &fpatch, &RunControl::default(), |_, _, _| Ok(())).unwrap();
+        let r = StretchCase::run(&p, &fpatch, &RunControl::default(), |_, _, _| Ok(())).unwrap();
         println!(
             "fpatch, predictor {predictor}: error {:.2e}, tau_yy {:?}",
             r.error, r.tau_yy

@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used)]
 
 use mpm_basis::{Gimp, LinearMpm};
+use mpm_cases::cases::Solve;
 use mpm_cases::cases::column::{self, ColumnParams};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{BasisKind, DomainUpdateKind, FormulationKind, Variant};
@@ -20,7 +21,7 @@ const SETTINGS: ColumnSettings = ColumnSettings {
 };
 
 fn framework_error(variant: Variant) -> f64 {
-    column::run(
+    column::ColumnCase::run(
         &ColumnParams::default(),
         &variant,
         &RunControl::default(),

@@ -6,7 +6,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use mpm_cases::cases::annulus::{AnnulusParams, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::annulus::{AnnulusCase, AnnulusParams};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::Variant;
 
@@ -69,7 +70,7 @@ pub fn study(full: bool) -> Study {
             points_per_element: n,
             ..AnnulusParams::default()
         };
-        match run(
+        match AnnulusCase::run(
             &p,
             &Variant::default(),
             &RunControl::default(),

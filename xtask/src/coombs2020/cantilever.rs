@@ -6,7 +6,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Result;
-use mpm_cases::cases::cantilever::{CantileverParams, elastica_tip, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::cantilever::{CantileverCase, CantileverParams, elastica_tip};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{DomainUpdateKind, Variant};
 
@@ -44,8 +45,8 @@ pub fn measure(variant: Variant, ppc: usize, h: f64) -> Outcome {
         points_per_cell: ppc,
         ..CantileverParams::default()
     };
-    let r =
-        run(&p, &variant, &RunControl::default(), |_, _, _| Ok(())).map_err(|e| e.to_string())?;
+    let r = CantileverCase::run(&p, &variant, &RunControl::default(), |_, _, _| Ok(()))
+        .map_err(|e| e.to_string())?;
     let tip: Vec<(f64, f64, f64)> = r
         .tip
         .iter()

@@ -5,7 +5,8 @@
 use std::fmt::Write as _;
 
 use anyhow::Result;
-use mpm_cases::cases::collapse::{CollapseParams, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::collapse::{CollapseCase, CollapseParams};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{BasisKind, DomainUpdateKind, Variant};
 
@@ -44,8 +45,8 @@ pub fn measure(variant: &Variant, ppc: usize, h: f64) -> Outcome {
         points_per_cell: ppc,
         ..CollapseParams::default()
     };
-    let r =
-        run(&p, variant, &RunControl::default(), |_, _, _| Ok(())).map_err(|e| e.to_string())?;
+    let r = CollapseCase::run(&p, variant, &RunControl::default(), |_, _, _| Ok(()))
+        .map_err(|e| e.to_string())?;
     let (mut max_rotation_deg, mut min_diag_f) = (0.0f64, f64::INFINITY);
     for f in &r.output.last.f {
         // Row-major 3×3: the in-plane block is f[0], f[1], f[3], f[4].

@@ -7,7 +7,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Result;
-use mpm_cases::cases::column::{ColumnParams, run};
+use mpm_cases::cases::Solve;
+use mpm_cases::cases::column::{ColumnCase, ColumnParams};
 use mpm_cases::run::RunControl;
 use mpm_cases::variant::{BasisKind, DomainUpdateKind, Variant};
 
@@ -64,8 +65,8 @@ fn run_once(variant: &Variant, k: i32) -> Outcome {
         h: cell_size(k),
         ..ColumnParams::default()
     };
-    let r =
-        run(&p, variant, &RunControl::default(), |_, _, _| Ok(())).map_err(|e| e.to_string())?;
+    let r = ColumnCase::run(&p, variant, &RunControl::default(), |_, _, _| Ok(()))
+        .map_err(|e| e.to_string())?;
     Ok(Measured {
         k,
         h: p.h,

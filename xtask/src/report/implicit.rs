@@ -3,6 +3,7 @@
 //! basis × formulation × locking × domain rule that applies to them.
 
 use mpm_cases::body::InitialDomain;
+use mpm_cases::cases::Solve;
 use mpm_cases::cases::annulus::{self, AnnulusParams};
 use mpm_cases::cases::column::{self, ColumnParams};
 use mpm_cases::cases::shear::{self, ShearParams};
@@ -195,8 +196,9 @@ pub fn column(mode: Mode) -> CaseSpec {
                         h: l.h,
                         ..ColumnParams::default()
                     };
-                    let r = column::run(&p, &v, &RunControl::default(), |_, _, _| Ok(()))
-                        .map_err(|e| e.to_string())?;
+                    let r =
+                        column::ColumnCase::run(&p, &v, &RunControl::default(), |_, _, _| Ok(()))
+                            .map_err(|e| e.to_string())?;
                     Ok(Sample {
                         error: r.error,
                         seconds: r.output.wall_time_s,
@@ -265,7 +267,7 @@ pub fn shear(mode: Mode) -> CaseSpec {
                         h: l.h,
                         ..ShearParams::default()
                     };
-                    let r = shear::run(&p, &v, &RunControl::default(), |_, _, _| Ok(()))
+                    let r = shear::ShearCase::run(&p, &v, &RunControl::default(), |_, _, _| Ok(()))
                         .map_err(|e| e.to_string())?;
                     Ok(Sample {
                         error: r.error,
@@ -321,8 +323,9 @@ pub fn annulus(mode: Mode) -> CaseSpec {
                         h: l.h,
                         ..AnnulusParams::default()
                     };
-                    let r = annulus::run(&p, &v, &RunControl::default(), |_, _, _| Ok(()))
-                        .map_err(|e| e.to_string())?;
+                    let r =
+                        annulus::AnnulusCase::run(&p, &v, &RunControl::default(), |_, _, _| Ok(()))
+                            .map_err(|e| e.to_string())?;
                     Ok(Sample {
                         error: r.error,
                         seconds: r.output.wall_time_s,
@@ -391,8 +394,9 @@ pub fn stretch(mode: Mode) -> CaseSpec {
                         cells: l.n,
                         ..StretchParams::default()
                     };
-                    let r = stretch::run(&p, &v, &RunControl::default(), |_, _, _| Ok(()))
-                        .map_err(|e| e.to_string())?;
+                    let r =
+                        stretch::StretchCase::run(&p, &v, &RunControl::default(), |_, _, _| Ok(()))
+                            .map_err(|e| e.to_string())?;
                     Ok(Sample {
                         error: r.error,
                         seconds: r.output.wall_time_s,

@@ -53,15 +53,18 @@
 
 use std::path::PathBuf;
 
-use mpm_solver::{SolverError, StepReport};
+use mpm_solver::SolverError;
 use nalgebra::Vector2;
+use serde_json::json;
 
+use super::{Case, Measured, Run, Solve, Solved};
 use crate::material::MaterialModel;
-use crate::run::{RunControl, RunOutput, Snapshot};
+use crate::run::RunOutput;
 use crate::scene::format::{
     BodySpec, BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, RegionSpec, SolverSpec,
 };
 use crate::scene::{Problem, Scene};
+use crate::session::Session;
 use crate::variant::Variant;
 
 pub use crate::manufactured::Torsion;
@@ -105,45 +108,13 @@ crate::case_params! {
 #[derive(Debug, Clone, Copy)]
 pub struct AnnulusCase;
 
-impl crate::cases::Case for AnnulusCase {
+impl Case for AnnulusCase {
     const NAME: &'static str = "annulus";
     const ABOUT: &'static str = "Coombs 2020 §7.4: elastic annulus under torsion on triangles (manufactured solution, Fig. 19)";
     type Params = AnnulusParams;
 
-    fn scene(p: &AnnulusParams) -> Result<Scene, SolverError> {
-        scene(p, &p.variant())
-    }
-
-    fn run(
-        mut p: AnnulusParams,
-        session: &crate::session::Session,
-    ) -> Result<(), crate::CasesError> {
-        session.resolve(&mut p.mesh);
-        let problem = problem(&p, &p.variant())?;
-        let mesh = super::simplices_of(&problem, "the annulus runs on triangles")?;
-        super::run_in_session(
-            Self::NAME,
-            &p,
-            p.variant(),
-            session,
-            mesh,
-            |control, obs| {
-                run_problem(&p, &problem, control, |s, rep, snap| obs.step(s, rep, snap))
-            },
-            |r| super::Measured {
-                output: &r.output,
-                material_points: r.material_points,
-                error: Some(r.error),
-                results: [
-                    ("max_error", serde_json::json!(r.max_error)),
-                    ("elements", serde_json::json!(r.elements)),
-                    ("element_size", serde_json::json!(r.element_size)),
-                ]
-                .into_iter()
-                .map(|(k, v)| (k.to_owned(), v))
-                .collect(),
-            },
-        )
+    fn scene(p: &AnnulusParams, variant: &Variant) -> Result<Scene, SolverError> {
+        scene(p, variant)
     }
 }
 
@@ -216,70 +187,51 @@ pub fn scene(p: &AnnulusParams, variant: &Variant) -> Result<Scene, SolverError>
         .with_solver(SolverSpec::implicit(variant, p.load_steps, p.tolerance)))
 }
 
-/// The annulus's scene, built.
-///
-/// # Errors
-/// As [`scene`], and the scene's own checks.
-pub fn problem(p: &AnnulusParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(&scene(p, variant)?, "annulus", 0)
-}
+impl Solve<2> for AnnulusCase {
+    type Built = Problem<2>;
+    type Result = AnnulusResult;
 
-/// Runs the annulus with `variant` (standard MPM on the triangles; UL or
-/// PC): its scene ([`scene`]), built and run, measured against the
-/// exact displacement.
-///
-/// # Errors
-/// As [`problem`] and [`run_problem`].
-pub fn run<O>(
-    p: &AnnulusParams,
-    variant: &Variant,
-    control: &RunControl,
-    observer: O,
-) -> Result<AnnulusResult, SolverError>
-where
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    run_problem(p, &problem(p, variant)?, control, observer)
-}
-
-/// Runs the built annulus and measures the displacement error.
-///
-/// # Errors
-/// Whatever the run returns.
-pub fn run_problem<O>(
-    p: &AnnulusParams,
-    problem: &Problem<2>,
-    control: &RunControl,
-    observer: O,
-) -> Result<AnnulusResult, SolverError>
-where
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    let output = crate::scene::run(problem, control, observer)?;
-    let (elements, area) = match &problem.mesh {
-        crate::scene::build::SceneMesh::Simplex(m) => (m.element_count(), m.total_volume()),
-        crate::scene::build::SceneMesh::Grid(_) => (0, 0.0),
-    };
-    let torsion = Torsion {
-        inner_radius: p.inner_radius,
-        outer_radius: p.outer_radius,
-        mu: p.youngs_modulus / (2.0 * (1.0 + p.poisson_ratio)),
-    };
-    let v0 = &problem.volume;
-    let (mut sum, mut max) = (0.0f64, 0.0f64);
-    for (q, u) in output.last.displacement.iter().enumerate() {
-        let x0 = Vector2::new(problem.position[q][0], problem.position[q][1]);
-        let exact = torsion.displacement(p.alpha, &x0);
-        let e = (Vector2::new(u[0], u[1]) - exact).norm();
-        sum += e * v0[q];
-        max = max.max(e);
+    /// Runs the built annulus and measures the displacement error.
+    fn solve(p: &AnnulusParams, problem: &Problem<2>, run: Run<'_, 2>) -> Solved<AnnulusResult> {
+        let output = run.on(problem)?;
+        let (elements, area) = match &problem.mesh {
+            crate::scene::build::SceneMesh::Simplex(m) => (m.element_count(), m.total_volume()),
+            crate::scene::build::SceneMesh::Grid(_) => (0, 0.0),
+        };
+        let torsion = Torsion {
+            inner_radius: p.inner_radius,
+            outer_radius: p.outer_radius,
+            mu: p.youngs_modulus / (2.0 * (1.0 + p.poisson_ratio)),
+        };
+        let v0 = &problem.volume;
+        let (mut sum, mut max) = (0.0f64, 0.0f64);
+        for (q, u) in output.last.displacement.iter().enumerate() {
+            let x0 = Vector2::new(problem.position[q][0], problem.position[q][1]);
+            let exact = torsion.displacement(p.alpha, &x0);
+            let e = (Vector2::new(u[0], u[1]) - exact).norm();
+            sum += e * v0[q];
+            max = max.max(e);
+        }
+        Ok(AnnulusResult {
+            error: sum / v0.iter().sum::<f64>(),
+            max_error: max,
+            material_points: problem.len(),
+            elements,
+            element_size: (2.0 * area / elements.max(1) as f64).sqrt(),
+            output,
+        })
     }
-    Ok(AnnulusResult {
-        error: sum / v0.iter().sum::<f64>(),
-        max_error: max,
-        material_points: problem.len(),
-        elements,
-        element_size: (2.0 * area / elements.max(1) as f64).sqrt(),
-        output,
-    })
+
+    fn measured(r: &AnnulusResult) -> Measured<'_, 2> {
+        Measured::new(&r.output, r.material_points, Some(r.error)).with([
+            ("max_error", json!(r.max_error)),
+            ("elements", json!(r.elements)),
+            ("element_size", json!(r.element_size)),
+        ])
+    }
+
+    /// A relative mesh path is taken from the scene file's directory.
+    fn prepare(p: &mut AnnulusParams, session: &Session) {
+        session.resolve(&mut p.mesh);
+    }
 }

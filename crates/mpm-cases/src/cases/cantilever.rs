@@ -10,15 +10,20 @@
 //! quadratic convergence).
 
 use mpm_solver::{SolverError, StepReport};
+use serde_json::json;
 
+use super::{Built, Case, Measured, Run, Solve, Solved};
+use crate::CasesError;
 use crate::material::MaterialModel;
-use crate::run::{RunControl, RunOutput, Snapshot};
+use crate::output::CellMesh;
+use crate::run::{RunOutput, Snapshot};
 use crate::scene::format::{
     Axes, BodySpec, BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, NodeSetSpec,
     RegionSpec, SolverSpec,
 };
 use crate::scene::{Problem, Scene};
 use crate::variant::Variant;
+use crate::writer::RunWriter;
 
 crate::case_params! {
     /// Parameters of the cantilever case (defaults: the paper's values).
@@ -55,54 +60,14 @@ crate::case_params! {
 #[derive(Debug, Clone, Copy)]
 pub struct CantileverCase;
 
-impl crate::cases::Case for CantileverCase {
+impl Case for CantileverCase {
     const NAME: &'static str = "cantilever";
     const ABOUT: &'static str =
         "Coombs 2020 §7.3: elastic cantilever under an end load (tip history, Newton residuals)";
     type Params = CantileverParams;
 
-    fn scene(p: &CantileverParams) -> Result<Scene, SolverError> {
-        scene(p, &p.variant())
-    }
-
-    fn run(
-        p: CantileverParams,
-        session: &crate::session::Session,
-    ) -> Result<(), crate::CasesError> {
-        use crate::session::observer_error;
-        let (problem, loaded) = problem(&p, &p.variant())?;
-        let mesh = super::grid_of(&problem, "the cantilever runs on a grid")?;
-        let step = |control: &_, obs: &mut crate::session::Observer<2, _>| {
-            run_problem(&problem, loaded, control, |s, rep, snap| {
-                // The case table first: the step's checkpoint must hold its row.
-                let (ux, uy) = tip_displacement(snap, loaded);
-                obs.writer
-                    .case_row(
-                        "tip.csv",
-                        &["load_factor", "tip_u_over_l0", "tip_v_over_l0"],
-                        &[
-                            rep.lambda1.into(),
-                            (ux / p.length).into(),
-                            (uy / p.length).into(),
-                        ],
-                    )
-                    .map_err(observer_error)?;
-                obs.step(s, rep, snap)
-            })
-        };
-        super::run_in_session(Self::NAME, &p, p.variant(), session, mesh, step, |r| {
-            super::Measured {
-                output: &r.output,
-                material_points: r.material_points,
-                error: None,
-                results: r
-                    .tip
-                    .last()
-                    .map(|(_, ux, uy)| ("tip_displacement".to_owned(), serde_json::json!([ux, uy])))
-                    .into_iter()
-                    .collect(),
-            }
-        })
+    fn scene(p: &CantileverParams, variant: &Variant) -> Result<Scene, SolverError> {
+        scene(p, variant)
     }
 }
 
@@ -199,23 +164,23 @@ pub fn scene(p: &CantileverParams, variant: &Variant) -> Result<Scene, SolverErr
 
 /// The cantilever's scene, built, and the indices of its two loaded
 /// points.
-///
-/// # Errors
-/// As [`scene`], the scene's own checks, and an end that does not
-/// hold exactly two points.
-pub fn problem(
-    p: &CantileverParams,
-    variant: &Variant,
-) -> Result<(Problem<2>, [usize; 2]), SolverError> {
-    let problem = super::build_scene(&scene(p, variant)?, "cantilever", variant.basis.padding())?;
-    match problem.point_forces.as_slice() {
-        [(a, _), (b, _)] => {
-            let loaded = [*a, *b];
-            Ok((problem, loaded))
+impl Built<2> for (Problem<2>, [usize; 2]) {
+    /// The two points the end load acts on; an end that does not hold
+    /// exactly two points is refused.
+    fn read(problem: Problem<2>) -> Result<Self, SolverError> {
+        match problem.point_forces.as_slice() {
+            [(a, _), (b, _)] => {
+                let loaded = [*a, *b];
+                Ok((problem, loaded))
+            }
+            _ => Err(SolverError::InvalidInput(
+                "the loaded end must hold two material points".into(),
+            )),
         }
-        _ => Err(SolverError::InvalidInput(
-            "the loaded end must hold two material points".into(),
-        )),
+    }
+
+    fn problem(&self) -> &Problem<2> {
+        &self.0
     }
 }
 
@@ -225,48 +190,51 @@ pub fn tip_displacement(snap: &Snapshot, loaded: [usize; 2]) -> (f64, f64) {
     (0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]))
 }
 
-/// Runs the built cantilever, recording the tip after every step.
-///
-/// # Errors
-/// Whatever the run returns.
-pub fn run_problem<O>(
-    problem: &Problem<2>,
-    loaded: [usize; 2],
-    control: &RunControl,
-    mut observer: O,
-) -> Result<CantileverResult, SolverError>
-where
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    let mut tip = Vec::new();
-    let output = crate::scene::run(problem, control, |step, report, snap| {
-        let (ux, uy) = tip_displacement(snap, loaded);
-        tip.push((report.lambda1, ux, uy));
-        observer(step, report, snap)
-    })?;
-    Ok(CantileverResult {
-        output,
-        tip,
-        material_points: problem.len(),
-    })
-}
+impl Solve<2> for CantileverCase {
+    type Built = (Problem<2>, [usize; 2]);
+    type Result = CantileverResult;
 
-/// Runs the cantilever with `variant`: its scene ([`scene`]), built
-/// and run.
-///
-/// # Errors
-/// As [`problem`] and [`run_problem`].
-pub fn run<O>(
-    params: &CantileverParams,
-    variant: &Variant,
-    control: &RunControl,
-    observer: O,
-) -> Result<CantileverResult, SolverError>
-where
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    let (problem, loaded) = problem(params, variant)?;
-    run_problem(&problem, loaded, control, observer)
+    /// Runs the built cantilever, recording the tip after every step.
+    fn solve(
+        _: &CantileverParams,
+        (problem, loaded): &Self::Built,
+        Run { control, observer }: Run<'_, 2>,
+    ) -> Solved<CantileverResult> {
+        let mut tip = Vec::new();
+        let output = crate::scene::run(problem, control, |step, report, snap| {
+            let (ux, uy) = tip_displacement(snap, *loaded);
+            tip.push((report.lambda1, ux, uy));
+            observer(step, report, snap)
+        })?;
+        Ok(CantileverResult {
+            output,
+            tip,
+            material_points: problem.len(),
+        })
+    }
+
+    fn measured(r: &CantileverResult) -> Measured<'_, 2> {
+        let m = Measured::new(&r.output, r.material_points, None);
+        match r.tip.last() {
+            Some((_, ux, uy)) => m.with([("tip_displacement", json!([ux, uy]))]),
+            None => m,
+        }
+    }
+
+    /// The tip displacement over the length against the load factor, in
+    /// `tip.csv`.
+    fn case_row<M: CellMesh<2>>(
+        p: &CantileverParams,
+        (_, loaded): &Self::Built,
+        writer: &mut RunWriter<2, M>,
+        report: &StepReport<2>,
+        snap: &Snapshot,
+    ) -> Result<(), CasesError> {
+        let (ux, uy) = tip_displacement(snap, *loaded);
+        let header = ["load_factor", "tip_u_over_l0", "tip_v_over_l0"];
+        let row = [report.lambda1, ux / p.length, uy / p.length];
+        writer.case_row("tip.csv", &header, &row.map(Into::into))
+    }
 }
 
 /// The large-deflection (elastica) solution of an inextensible cantilever

@@ -14,10 +14,12 @@
 //! points per cell), while the bare point positions fall short by exactly
 //! $l^0_p$ (1.2 % and 2.7 % for 3²).
 
-use mpm_solver::{SolverError, StepReport};
+use mpm_solver::SolverError;
+use serde_json::json;
 
+use super::{Case, Measured, Run, Solve, Solved};
 use crate::material::MaterialModel;
-use crate::run::{RunControl, RunOutput, Snapshot};
+use crate::run::RunOutput;
 use crate::scene::format::{
     BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, SolverSpec,
 };
@@ -56,38 +58,13 @@ crate::case_params! {
 #[derive(Debug, Clone, Copy)]
 pub struct CollapseCase;
 
-impl crate::cases::Case for CollapseCase {
+impl Case for CollapseCase {
     const NAME: &'static str = "collapse";
     const ABOUT: &'static str = "Coombs 2020 §7.5: elasto-plastic collapse of a block (Tables 6-7)";
     type Params = CollapseParams;
 
-    fn scene(p: &CollapseParams) -> Result<Scene, SolverError> {
-        scene(p, &p.variant())
-    }
-
-    fn run(p: CollapseParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
-        let problem = problem(&p, &p.variant())?;
-        let mesh = super::grid_of(&problem, "the collapse runs on a grid")?;
-        super::run_in_session(
-            Self::NAME,
-            &p,
-            p.variant(),
-            session,
-            mesh,
-            |control, obs| run_problem(&problem, control, |s, rep, snap| obs.step(s, rep, snap)),
-            |r| super::Measured {
-                output: &r.output,
-                material_points: r.material_points,
-                error: None,
-                results: [
-                    ("horizontal_extent", r.horizontal_extent),
-                    ("max_height", r.max_height),
-                ]
-                .into_iter()
-                .map(|(k, v)| (k.to_owned(), serde_json::json!(v)))
-                .collect(),
-            },
-        )
+    fn scene(p: &CollapseParams, variant: &Variant) -> Result<Scene, SolverError> {
+        scene(p, variant)
     }
 }
 
@@ -136,66 +113,43 @@ pub fn scene(p: &CollapseParams, variant: &Variant) -> Result<Scene, SolverError
     )
 }
 
-/// The collapse's scene, built.
-///
-/// # Errors
-/// As [`scene`], and the scene's own checks.
-pub fn problem(p: &CollapseParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(&scene(p, variant)?, "collapse", variant.basis.padding())
-}
+impl Solve<2> for CollapseCase {
+    type Built = Problem<2>;
+    type Result = CollapseResult;
 
-/// Runs the built collapse and measures the body's extent.
-///
-/// # Errors
-/// Whatever the run returns.
-pub fn run_problem<O>(
-    problem: &Problem<2>,
-    control: &RunControl,
-    observer: O,
-) -> Result<CollapseResult, SolverError>
-where
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    let output = crate::scene::run(problem, control, observer)?;
-    // The edge of the body: of the domains where the basis has them
-    // (GIMP, CPDI2), else of the points' initial half-spacing l0.
-    let last = &output.last;
-    let edge = |axis: usize| {
-        if last.domain_bounds.is_empty() {
-            last.position
-                .iter()
-                .zip(&problem.half_lengths)
-                .map(|(x, l)| x[axis] + l[axis])
-                .fold(f64::NEG_INFINITY, f64::max)
-        } else {
-            last.domain_bounds
-                .iter()
-                .map(|(_, hi)| hi[axis])
-                .fold(f64::NEG_INFINITY, f64::max)
-        }
-    };
-    let (horizontal_extent, max_height) = (edge(0), edge(1));
-    Ok(CollapseResult {
-        output,
-        horizontal_extent,
-        max_height,
-        material_points: problem.len(),
-    })
-}
+    /// Runs the built collapse and measures the body's extent.
+    fn solve(_: &CollapseParams, problem: &Problem<2>, run: Run<'_, 2>) -> Solved<CollapseResult> {
+        let output = run.on(problem)?;
+        // The edge of the body: of the domains where the basis has them
+        // (GIMP, CPDI2), else of the points' initial half-spacing l0.
+        let last = &output.last;
+        let edge = |axis: usize| {
+            if last.domain_bounds.is_empty() {
+                last.position
+                    .iter()
+                    .zip(&problem.half_lengths)
+                    .map(|(x, l)| x[axis] + l[axis])
+                    .fold(f64::NEG_INFINITY, f64::max)
+            } else {
+                last.domain_bounds
+                    .iter()
+                    .map(|(_, hi)| hi[axis])
+                    .fold(f64::NEG_INFINITY, f64::max)
+            }
+        };
+        let (horizontal_extent, max_height) = (edge(0), edge(1));
+        Ok(CollapseResult {
+            output,
+            horizontal_extent,
+            max_height,
+            material_points: problem.len(),
+        })
+    }
 
-/// Runs the collapse with `variant`: its scene ([`scene`]), built and
-/// run.
-///
-/// # Errors
-/// As [`problem`] and [`run_problem`].
-pub fn run<O>(
-    params: &CollapseParams,
-    variant: &Variant,
-    control: &RunControl,
-    observer: O,
-) -> Result<CollapseResult, SolverError>
-where
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    run_problem(&problem(params, variant)?, control, observer)
+    fn measured(r: &CollapseResult) -> Measured<'_, 2> {
+        Measured::new(&r.output, r.material_points, None).with([
+            ("horizontal_extent", json!(r.horizontal_extent)),
+            ("max_height", json!(r.max_height)),
+        ])
+    }
 }

@@ -10,8 +10,9 @@
 
 use mpm_solver::SolverError;
 
+use super::{Case, Measured, Run, Solve, Solved};
 use crate::material::MaterialModel;
-use crate::run::{RunControl, RunOutput, Snapshot};
+use crate::run::{RunOutput, Snapshot};
 use crate::scene::format::{
     BoundaryKind, BoundarySpec, LoadSpec, MaterialSpec, MeshSpec, SolverSpec,
 };
@@ -52,34 +53,13 @@ crate::case_params! {
 #[derive(Debug, Clone, Copy)]
 pub struct ColumnCase;
 
-impl crate::cases::Case for ColumnCase {
+impl Case for ColumnCase {
     const NAME: &'static str = "column";
     const ABOUT: &'static str = "Coombs 2020 §7.1: elastic column compacting under self weight (analytic eq. 41, error eq. 42)";
     type Params = ColumnParams;
 
-    fn scene(p: &ColumnParams) -> Result<Scene, SolverError> {
-        scene(p, &p.variant())
-    }
-
-    fn run(p: ColumnParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
-        let problem = problem(&p, &p.variant())?;
-        let mesh = super::grid_of(&problem, "the column runs on a grid")?;
-        super::run_in_session(
-            Self::NAME,
-            &p,
-            p.variant(),
-            session,
-            mesh,
-            |control, obs| {
-                run_problem(&p, &problem, control, |s, rep, snap| obs.step(s, rep, snap))
-            },
-            |r| super::Measured {
-                output: &r.output,
-                material_points: r.material_points,
-                error: Some(r.error),
-                results: serde_json::Map::new(),
-            },
-        )
+    fn scene(p: &ColumnParams, variant: &Variant) -> Result<Scene, SolverError> {
+        scene(p, variant)
     }
 }
 
@@ -148,50 +128,23 @@ pub fn scene(p: &ColumnParams, variant: &Variant) -> Result<Scene, SolverError> 
     )
 }
 
-/// The column's scene, built.
-///
-/// # Errors
-/// As [`scene`], and the scene's own checks.
-pub fn problem(p: &ColumnParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(&scene(p, variant)?, "column", variant.basis.padding())
-}
+impl Solve<2> for ColumnCase {
+    type Built = Problem<2>;
+    type Result = ColumnResult;
 
-/// Runs the built column and measures it against eq. (42).
-///
-/// # Errors
-/// Whatever the run returns.
-pub fn run_problem<O>(
-    p: &ColumnParams,
-    problem: &Problem<2>,
-    control: &RunControl,
-    observer: O,
-) -> Result<ColumnResult, SolverError>
-where
-    O: FnMut(usize, &mpm_solver::StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    let output = crate::scene::run(problem, control, observer)?;
-    let z0: Vec<f64> = problem.position.iter().map(|x| x[1]).collect();
-    let error = p.error(&output.last, &z0, &problem.volume);
-    Ok(ColumnResult {
-        output,
-        error,
-        material_points: problem.len(),
-    })
-}
+    /// Runs the built column and measures it against eq. (42).
+    fn solve(p: &ColumnParams, problem: &Problem<2>, run: Run<'_, 2>) -> Solved<ColumnResult> {
+        let output = run.on(problem)?;
+        let z0: Vec<f64> = problem.position.iter().map(|x| x[1]).collect();
+        let error = p.error(&output.last, &z0, &problem.volume);
+        Ok(ColumnResult {
+            output,
+            error,
+            material_points: problem.len(),
+        })
+    }
 
-/// Runs the column with `variant`: its scene ([`scene`]), built and
-/// run, measured against eq. (42).
-///
-/// # Errors
-/// As [`problem`] and [`run_problem`].
-pub fn run<O>(
-    params: &ColumnParams,
-    variant: &Variant,
-    control: &RunControl,
-    observer: O,
-) -> Result<ColumnResult, SolverError>
-where
-    O: FnMut(usize, &mpm_solver::StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    run_problem(params, &problem(params, variant)?, control, observer)
+    fn measured(r: &ColumnResult) -> Measured<'_, 2> {
+        Measured::new(&r.output, r.material_points, Some(r.error))
+    }
 }

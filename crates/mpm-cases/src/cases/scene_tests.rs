@@ -111,7 +111,7 @@ fn a_case_scene_error_names_the_case_not_a_line() {
         youngs_modulus: -5.0,
         ..Default::default()
     };
-    let e = column::problem(&p, &p.variant())
+    let e = <column::ColumnCase as super::Solve<2>>::build(&p, &p.variant())
         .map(|_| ())
         .expect_err("a negative modulus is refused");
     let message = e.to_string();

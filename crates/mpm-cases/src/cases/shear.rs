@@ -40,11 +40,12 @@
 use mpm_constitutive::{
     HenckyElastic, LogStrainLaw, MaterialState, VonMises, tensor::embed, update,
 };
-use mpm_solver::{Flat, SolverError, StepReport};
+use mpm_solver::{Flat, SolverError};
 use nalgebra::{Matrix2, Matrix3};
 
+use super::{Case, Measured, Run, Solve, Solved};
 use crate::material::MaterialModel;
-use crate::run::{Checkpoint, RunControl, RunOutput, Snapshot};
+use crate::run::{Checkpoint, RunOutput};
 use crate::scene::format::{
     BodySpec, BoundaryKind, BoundarySpec, MaterialSpec, MeshSpec, NodeSetSpec, SolverSpec,
 };
@@ -84,34 +85,13 @@ crate::case_params! {
 #[derive(Debug, Clone, Copy)]
 pub struct ShearCase;
 
-impl crate::cases::Case for ShearCase {
+impl Case for ShearCase {
     const NAME: &'static str = "shear";
     const ABOUT: &'static str = "Coombs 2020 §7.2: simple shear of a unit square, elastic or perfectly plastic (homogeneous)";
     type Params = ShearParams;
 
-    fn scene(p: &ShearParams) -> Result<Scene, SolverError> {
-        scene(p, &p.variant())
-    }
-
-    fn run(p: ShearParams, session: &crate::session::Session) -> Result<(), crate::CasesError> {
-        let problem = problem(&p, &p.variant())?;
-        let mesh = super::grid_of(&problem, "the shear runs on a grid")?;
-        super::run_in_session(
-            Self::NAME,
-            &p,
-            p.variant(),
-            session,
-            mesh,
-            |control, obs| {
-                run_problem(&p, &problem, control, |s, rep, snap| obs.step(s, rep, snap))
-            },
-            |r| super::Measured {
-                output: &r.output,
-                material_points: r.material_points,
-                error: Some(r.error),
-                results: serde_json::Map::new(),
-            },
-        )
+    fn scene(p: &ShearParams, variant: &Variant) -> Result<Scene, SolverError> {
+        scene(p, variant)
     }
 }
 
@@ -258,67 +238,39 @@ pub fn scene(p: &ShearParams, variant: &Variant) -> Result<Scene, SolverError> {
     ))
 }
 
-/// The shear's scene, built.
-///
-/// # Errors
-/// As [`scene`], and the scene's own checks.
-pub fn problem(p: &ShearParams, variant: &Variant) -> Result<Problem<2>, SolverError> {
-    super::build_scene(&scene(p, variant)?, "shear", variant.basis.padding())
-}
+impl Solve<2> for ShearCase {
+    type Built = Problem<2>;
+    type Result = ShearResult;
 
-/// Runs the shear with `variant`: its scene ([`scene`]), built and
-/// run, every point's stress measured against the single-point reference.
-///
-/// # Errors
-/// As [`problem`] and [`run_problem`].
-pub fn run<O>(
-    params: &ShearParams,
-    variant: &Variant,
-    control: &RunControl,
-    observer: O,
-) -> Result<ShearResult, SolverError>
-where
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    run_problem(params, &problem(params, variant)?, control, observer)
-}
+    /// Runs the built shear, every point's stress measured against the
+    /// single-point reference of its law.
+    fn solve(p: &ShearParams, problem: &Problem<2>, run: Run<'_, 2>) -> Solved<ShearResult> {
+        match p.yield_stress {
+            None => {
+                let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio)?;
+                with_reference(p, problem, run, law)
+            }
+            Some(y) => {
+                let law = VonMises::new(p.youngs_modulus, p.poisson_ratio, y, 0.0)?;
+                with_reference(p, problem, run, law)
+            }
+        }
+    }
 
-/// Runs the built shear against the single-point reference of its law.
-///
-/// # Errors
-/// Whatever the run returns.
-pub fn run_problem<O>(
-    p: &ShearParams,
-    problem: &Problem<2>,
-    control: &RunControl,
-    observer: O,
-) -> Result<ShearResult, SolverError>
-where
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
-{
-    match p.yield_stress {
-        None => {
-            let law = HenckyElastic::new(p.youngs_modulus, p.poisson_ratio)?;
-            with_reference(p, problem, control, observer, law)
-        }
-        Some(y) => {
-            let law = VonMises::new(p.youngs_modulus, p.poisson_ratio, y, 0.0)?;
-            with_reference(p, problem, control, observer, law)
-        }
+    fn measured(r: &ShearResult) -> Measured<'_, 2> {
+        Measured::new(&r.output, r.material_points, Some(r.error))
     }
 }
 
-fn with_reference<L, O>(
+fn with_reference<L>(
     p: &ShearParams,
     problem: &Problem<2>,
-    control: &RunControl,
-    mut observer: O,
+    Run { control, observer }: Run<'_, 2>,
     law: L,
-) -> Result<ShearResult, SolverError>
+) -> Solved<ShearResult>
 where
     L: LogStrainLaw,
     L::History: Flat,
-    O: FnMut(usize, &StepReport<2>, &Snapshot) -> Result<(), SolverError>,
 {
     let mut reference = SinglePoint::new(law);
     // On resume: the largest error so far and the reference's state.

@@ -26,16 +26,19 @@
 
 use std::path::PathBuf;
 
-use mpm_solver::{SolverError, StepReport};
+use mpm_solver::SolverError;
 use nalgebra::Matrix3;
+use serde_json::json;
 
+use super::{Case, Measured, Run, Solve, Solved};
 use crate::material::MaterialModel;
-use crate::run::{RunControl, RunOutput, Snapshot};
+use crate::run::RunOutput;
 use crate::scene::format::{
     Axes, BodySpec, BoundaryKind, BoundarySpec, MaterialSpec, MeshSpec, MotionSpec, Placement,
     RegionSpec, SolverSpec,
 };
 use crate::scene::{Problem, Scene};
+use crate::session::Session;
 use crate::variant::Variant;
 
 crate::case_params! {
@@ -84,48 +87,14 @@ crate::case_params! {
 #[derive(Debug, Clone, Copy)]
 pub struct StretchCase;
 
-impl crate::cases::Case for StretchCase {
+impl Case for StretchCase {
     const NAME: &'static str = "stretch";
     const ABOUT: &'static str =
         "Wang 2021 §5.3: simple stretch of a cube on tetrahedra with a moving mesh (Table 1)";
     type Params = StretchParams;
 
-    fn scene(p: &StretchParams) -> Result<Scene, SolverError> {
-        scene(p, &p.variant())
-    }
-
-    fn run(
-        mut p: StretchParams,
-        session: &crate::session::Session,
-    ) -> Result<(), crate::CasesError> {
-        session.resolve(&mut p.mesh);
-        let problem = problem(&p, &p.variant())?;
-        let mesh = super::simplices_of(&problem, "the stretch runs on tetrahedra")?;
-        super::run_in_session(
-            Self::NAME,
-            &p,
-            p.variant(),
-            session,
-            mesh,
-            |control, obs| {
-                run_problem(&p, &problem, control, |s, rep, snap| obs.step(s, rep, snap))
-            },
-            |r| super::Measured {
-                output: &r.output,
-                material_points: r.material_points,
-                error: Some(r.error),
-                results: [
-                    ("analytic_stress", serde_json::json!(r.analytic_stress)),
-                    ("tau_yy_mean", serde_json::json!(r.tau_yy.0)),
-                    ("tau_yy_min", serde_json::json!(r.tau_yy.1)),
-                    ("tau_yy_max", serde_json::json!(r.tau_yy.2)),
-                    ("elements", serde_json::json!(r.elements)),
-                ]
-                .into_iter()
-                .map(|(k, v)| (k.to_owned(), v))
-                .collect(),
-            },
-        )
+    fn scene(p: &StretchParams, variant: &Variant) -> Result<Scene, SolverError> {
+        scene(p, variant)
     }
 }
 
@@ -213,83 +182,68 @@ pub fn scene(p: &StretchParams, variant: &Variant) -> Result<Scene, SolverError>
     )
 }
 
-/// The stretch's scene, built.
-///
-/// # Errors
-/// As [`scene`], and the scene's own checks.
-pub fn problem(p: &StretchParams, variant: &Variant) -> Result<Problem<3>, SolverError> {
-    super::build_scene(&scene(p, variant)?, "stretch", 0)
-}
+impl Solve<3> for StretchCase {
+    type Built = Problem<3>;
+    type Result = StretchResult;
 
-/// Runs the stretch with `variant` (standard MPM or F-patch; UL or PC):
-/// its scene ([`scene`]), built and run, measured against the
-/// uniaxial stress.
-///
-/// # Errors
-/// As [`problem`] and [`run_problem`].
-pub fn run<O>(
-    p: &StretchParams,
-    variant: &Variant,
-    control: &RunControl,
-    observer: O,
-) -> Result<StretchResult, SolverError>
-where
-    O: FnMut(usize, &StepReport<3>, &Snapshot) -> Result<(), SolverError>,
-{
-    run_problem(p, &problem(p, variant)?, control, observer)
-}
+    /// Runs the built stretch (standard MPM or F-patch; UL or PC) and
+    /// measures it against the uniaxial stress.
+    fn solve(p: &StretchParams, problem: &Problem<3>, run: Run<'_, 3>) -> Solved<StretchResult> {
+        let output = run.on(problem)?;
+        let elements = match &problem.mesh {
+            crate::scene::build::SceneMesh::Simplex(m) => m.element_count(),
+            crate::scene::build::SceneMesh::Grid(_) => 0,
+        };
+        let body = problem;
+        let tau_a = p.analytic_stress();
+        let taus: Vec<f64> = output
+            .last
+            .sigma
+            .iter()
+            .zip(&output.last.f)
+            .map(|(s, f)| s[4] * Matrix3::from_row_slice(f).determinant())
+            .collect();
+        let total: f64 = body.volume.iter().sum();
+        let error = taus
+            .iter()
+            .zip(&body.volume)
+            .map(|(t, v)| (t - tau_a).abs() * v)
+            .sum::<f64>()
+            / (total * tau_a);
+        let mean = taus
+            .iter()
+            .zip(&body.volume)
+            .map(|(t, v)| t * v)
+            .sum::<f64>()
+            / total;
+        let (lo, hi) = taus
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
+                (a.min(t), b.max(t))
+            });
+        Ok(StretchResult {
+            output,
+            error,
+            analytic_stress: tau_a,
+            tau_yy: (mean, lo, hi),
+            material_points: problem.len(),
+            elements,
+        })
+    }
 
-/// Runs the built stretch and measures it.
-///
-/// # Errors
-/// Whatever the run returns.
-pub fn run_problem<O>(
-    p: &StretchParams,
-    problem: &Problem<3>,
-    control: &RunControl,
-    observer: O,
-) -> Result<StretchResult, SolverError>
-where
-    O: FnMut(usize, &StepReport<3>, &Snapshot) -> Result<(), SolverError>,
-{
-    let output = crate::scene::run(problem, control, observer)?;
-    let elements = match &problem.mesh {
-        crate::scene::build::SceneMesh::Simplex(m) => m.element_count(),
-        crate::scene::build::SceneMesh::Grid(_) => 0,
-    };
-    let body = problem;
-    let tau_a = p.analytic_stress();
-    let taus: Vec<f64> = output
-        .last
-        .sigma
-        .iter()
-        .zip(&output.last.f)
-        .map(|(s, f)| s[4] * Matrix3::from_row_slice(f).determinant())
-        .collect();
-    let total: f64 = body.volume.iter().sum();
-    let error = taus
-        .iter()
-        .zip(&body.volume)
-        .map(|(t, v)| (t - tau_a).abs() * v)
-        .sum::<f64>()
-        / (total * tau_a);
-    let mean = taus
-        .iter()
-        .zip(&body.volume)
-        .map(|(t, v)| t * v)
-        .sum::<f64>()
-        / total;
-    let (lo, hi) = taus
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
-            (a.min(t), b.max(t))
-        });
-    Ok(StretchResult {
-        output,
-        error,
-        analytic_stress: tau_a,
-        tau_yy: (mean, lo, hi),
-        material_points: problem.len(),
-        elements,
-    })
+    fn measured(r: &StretchResult) -> Measured<'_, 3> {
+        let (mean, min, max) = r.tau_yy;
+        Measured::new(&r.output, r.material_points, Some(r.error)).with([
+            ("analytic_stress", json!(r.analytic_stress)),
+            ("tau_yy_mean", json!(mean)),
+            ("tau_yy_min", json!(min)),
+            ("tau_yy_max", json!(max)),
+            ("elements", json!(r.elements)),
+        ])
+    }
+
+    /// A relative mesh path is taken from the scene file's directory.
+    fn prepare(p: &mut StretchParams, session: &Session) {
+        session.resolve(&mut p.mesh);
+    }
 }
