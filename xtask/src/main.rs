@@ -32,6 +32,10 @@
 //! - `column-table`: error and solver time of the column for standard MPM
 //!   and GIMP (eq. 34), written to `docs/src/benchmarks/column.md`
 //!   ([`column_table`]).
+//! - `linear-petsc [--full]`: the full vane's linear solves by our
+//!   ILU(0)/BiCGSTAB and by PETSc's preconditioners, written to
+//!   `docs/src/benchmarks/petsc.md` ([`petsc`]; xtask built with
+//!   `--features petsc`).
 //! - `structure [--deny]`: functions over 150 lines and import circles
 //!   between files ([`structure`]).
 //! - `reference-values`: reruns the cases of `mpm-cases` with the settings
@@ -48,6 +52,7 @@ mod locking;
 mod machine;
 mod markdown;
 mod mpoint;
+mod petsc;
 mod plate;
 mod plot;
 mod reference_values;
@@ -110,6 +115,10 @@ tasks:
                 reruns the cases with the settings of the tests and writes the
                 committed regression values crates/mpm-cases/tests/reference_values/
                 (*.json, one per case) that tests/regression.rs compares against
+  linear-petsc [--full]
+                the full vane with F-patch solved by our ILU(0)/BiCGSTAB and by PETSc's
+                GAMG, BoomerAMG and block Jacobi (xtask built with --features petsc);
+                writes docs/src/benchmarks/petsc.md. --full: the paper's mesh (slow)
   structure [--deny]
                 functions over 150 lines and import circles between files in every
                 crate's src/ (tests left out); --deny fails on any
@@ -139,12 +148,12 @@ fn main() -> Result<()> {
             report::run(&docs_dir(), mode)
         }
         Some("structure") => {
-            let deny = match &args[1..] {
-                [] => false,
-                [flag] if flag == "--deny" => true,
-                [other, ..] => bail!("unexpected argument `{other}` (expected --deny)"),
-            };
+            let deny = flag(&args[1..], "--deny")?;
             structure::run(&workspace_dir(), deny)
+        }
+        Some("linear-petsc") => {
+            let full = flag(&args[1..], "--full")?;
+            petsc::linear_petsc(full, &workspace_dir())
         }
         Some("column-table") => {
             no_more_arguments(&args[1..])?;
@@ -160,11 +169,7 @@ fn main() -> Result<()> {
                 coombs2020::run(&options, &docs_dir())
             }
             Some("wang2021") => {
-                let full = match &args[2..] {
-                    [] => false,
-                    [flag] if flag == "--full" => true,
-                    [other, ..] => bail!("unexpected argument `{other}` (expected --full)"),
-                };
+                let full = flag(&args[2..], "--full")?;
                 wang2021::run_report(full, &docs_dir())
             }
             Some("locking") => {
@@ -172,11 +177,7 @@ fn main() -> Result<()> {
                 locking::run(&docs_dir())
             }
             Some("mpoint") => {
-                let full = match &args[2..] {
-                    [] => false,
-                    [flag] if flag == "--full" => true,
-                    [other, ..] => bail!("unexpected argument `{other}` (expected --full)"),
-                };
+                let full = flag(&args[2..], "--full")?;
                 mpoint::run(full, &docs_dir())
             }
             Some(other) => {
@@ -187,6 +188,16 @@ fn main() -> Result<()> {
             }
         },
         Some(other) => bail!("unknown task `{other}`\n\n{USAGE}"),
+    }
+}
+
+/// Whether the task's only optional argument `name` (`--full`) is given;
+/// anything else is refused.
+fn flag(rest: &[String], name: &str) -> Result<bool> {
+    match rest {
+        [] => Ok(false),
+        [given] if given == name => Ok(true),
+        [other, ..] => bail!("unexpected argument `{other}` (expected {name})"),
     }
 }
 

@@ -112,8 +112,13 @@ pub fn run(
         times: mpm_solver::StageTimes::default(),
         free_dofs: 0,
     };
+    // PETSc's solvers when xtask is built with them (`--features petsc`).
+    let control = RunControl {
+        external_linear: mpm_cases::distributed::external_linear(),
+        ..RunControl::default()
+    };
     let (result, seconds, peak): (Result<RunOutput<3>, _>, _, _) = measured(|| {
-        mpm_cases::scene::run(&problem, &RunControl::default(), |_, report, _| {
+        mpm_cases::scene::run(&problem, &control, |_, report, _| {
             run.points.push(point(&problem, &on, report));
             run.residuals.push(report.residuals.clone());
             run.iterations += report.iterations();

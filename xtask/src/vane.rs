@@ -68,7 +68,26 @@ fn run(mesh: &str, fpatch: bool, points: usize) -> Result<Curve> {
 /// One run with `points` per element: 1 (the centroid), 4 (Gauss) or 11
 /// (Keast).
 fn run_scene(spec: &Spec, mesh: &str, fpatch: bool, points: usize) -> Result<Curve> {
+    run_with(spec, mesh, fpatch, points, &[])
+}
+
+/// The full vane on `mesh` (F-patch or standard MPM, one point per
+/// element) with `extra` overrides (the linear solver), labelled `label`.
+pub fn full_with(mesh: &str, fpatch: bool, extra: &[String], label: &str) -> Result<Run> {
+    let mut curve = run_with(&FULL, mesh, fpatch, 1, extra)?;
+    curve.run.label = label.to_owned();
+    Ok(curve.run)
+}
+
+fn run_with(
+    spec: &Spec,
+    mesh: &str,
+    fpatch: bool,
+    points: usize,
+    extra: &[String],
+) -> Result<Curve> {
     let mut overrides = vec![format!("mesh.file=\"{mesh}\"")];
+    overrides.extend_from_slice(extra);
     if fpatch {
         overrides.push("solver.locking=\"fpatch\"".to_owned());
     }

@@ -34,6 +34,7 @@ pub mod session;
 pub mod writer;
 
 pub use mpm_dispatch::run;
+pub use mpm_distributed as distributed;
 pub use mpm_output as output;
 pub use mpm_scene::source as scene_file;
 pub use mpm_scene::{body, manufactured, material, variant};

@@ -336,7 +336,7 @@ fn malformed_scenes_are_refused_with_a_located_message() {
         (
             "steps = 2",
             "steps = 2\nlinear = \"direct\"\nlinear_tolerance = 1e-10",
-            "bad.toml:29:20: solver `linear_tolerance` applies to the iterative solver (`linear = \"iterative\"` or `\"auto\"`) only",
+            "bad.toml:29:20: solver `linear_tolerance` applies to the iterative solvers (`linear = \"iterative\"`, `\"auto\"` or `{ petsc = ... }`) only",
         ),
         (
             "steps = 2",
