@@ -70,6 +70,12 @@ pub struct Response<H> {
     pub be_n: Matrix3<f64>,
     /// Spectral decomposition of $b^{e,tr}$.
     pub trial_be: SymSpectral,
+    /// Principal trial elastic Hencky strains $\tfrac12\ln\lambda_a$ of
+    /// $b^{e,tr}$ (the values of [`Self::trial_strain`]), kept from the
+    /// update: the tangents read them again, and a law chosen at run time
+    /// (an enum over laws) cannot let the compiler drop the logarithms
+    /// for the laws whose tangent ignores them, as a typed law does.
+    pub trial_strain_values: Vector3<f64>,
     /// The law's return-map result (principal values in the basis of
     /// `trial_be`).
     pub law_state: LawState<H>,
@@ -86,9 +92,10 @@ impl<H: Copy> Response<H> {
 
     /// Spectral decomposition of the trial elastic Hencky strain
     /// $\varepsilon^{e,tr} = \tfrac12\ln b^{e,tr}$ (same basis as $b^{e,tr}$).
+    #[inline]
     pub fn trial_strain(&self) -> SymSpectral {
         SymSpectral {
-            values: self.trial_be.values.map(|l| 0.5 * l.ln()),
+            values: self.trial_strain_values,
             vectors: self.trial_be.vectors,
         }
     }
@@ -144,6 +151,7 @@ pub fn update<L: LogStrainLaw>(
             history: law_state.history,
         },
         be_n: state_n.be,
+        trial_strain_values: trial_eps.values,
         trial_be,
         law_state,
         history_n: state_n.history,
