@@ -86,6 +86,7 @@ pub struct Response<H> {
 impl<H: Copy> Response<H> {
     /// The previously converged stress $\tilde P = \tau\Delta F^{-T}/J_n$
     /// (eq. 18), work-conjugate to $\Delta F$ per unit volume $V^n_p$.
+    #[inline]
     pub fn p_tilde(&self) -> Matrix3<f64> {
         self.tau * self.delta_f_inv.transpose() / self.j_n
     }
@@ -169,6 +170,7 @@ pub struct TangentParts {
 
 impl TangentParts {
     /// $D^{alg}$ and $L$ of a response.
+    #[inline(always)]
     pub fn new<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Self> {
         let d_alg = law.algorithmic_tangent(&r.trial_strain(), &r.history_n, &r.law_state);
         Ok(Self {
@@ -179,6 +181,7 @@ impl TangentParts {
 
     /// $D$ for continued loading ([`LogStrainLaw::loading_tangent`]) and
     /// $L$ of a response.
+    #[inline(always)]
     pub fn loading<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Self> {
         let d_alg = law.loading_tangent(&r.trial_strain(), &r.history_n, &r.law_state);
         Ok(Self {
@@ -195,11 +198,13 @@ pub trait ConsistentTangent: Send + Sync + 'static {
     fn assemble<H: Copy>(r: &Response<H>, parts: &TangentParts) -> Tensor4;
 
     /// Convenience: the tangent straight from the law and the response.
+    #[inline(always)]
     fn tangent<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Tensor4> {
         Ok(Self::assemble(r, &TangentParts::new(law, r)?))
     }
 
     /// The tangent for continued loading ([`TangentParts::loading`]).
+    #[inline(always)]
     fn loading_tangent<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Tensor4> {
         Ok(Self::assemble(r, &TangentParts::loading(law, r)?))
     }
