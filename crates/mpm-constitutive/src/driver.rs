@@ -70,6 +70,12 @@ pub struct Response<H> {
     pub be_n: Matrix3<f64>,
     /// Spectral decomposition of $b^{e,tr}$.
     pub trial_be: SymSpectral,
+    /// Principal trial elastic Hencky strains $\tfrac12\ln\lambda_a$ of
+    /// $b^{e,tr}$ (the values of [`Self::trial_strain`]), kept from the
+    /// update: the tangents read them again, and a law chosen at run time
+    /// (an enum over laws) cannot let the compiler drop the logarithms
+    /// for the laws whose tangent ignores them, as a typed law does.
+    pub trial_strain_values: Vector3<f64>,
     /// The law's return-map result (principal values in the basis of
     /// `trial_be`).
     pub law_state: LawState<H>,
@@ -80,15 +86,17 @@ pub struct Response<H> {
 impl<H: Copy> Response<H> {
     /// The previously converged stress $\tilde P = \tau\Delta F^{-T}/J_n$
     /// (eq. 18), work-conjugate to $\Delta F$ per unit volume $V^n_p$.
+    #[inline]
     pub fn p_tilde(&self) -> Matrix3<f64> {
         self.tau * self.delta_f_inv.transpose() / self.j_n
     }
 
     /// Spectral decomposition of the trial elastic Hencky strain
     /// $\varepsilon^{e,tr} = \tfrac12\ln b^{e,tr}$ (same basis as $b^{e,tr}$).
+    #[inline]
     pub fn trial_strain(&self) -> SymSpectral {
         SymSpectral {
-            values: self.trial_be.values.map(|l| 0.5 * l.ln()),
+            values: self.trial_strain_values,
             vectors: self.trial_be.vectors,
         }
     }
@@ -144,6 +152,7 @@ pub fn update<L: LogStrainLaw>(
             history: law_state.history,
         },
         be_n: state_n.be,
+        trial_strain_values: trial_eps.values,
         trial_be,
         law_state,
         history_n: state_n.history,
@@ -161,6 +170,7 @@ pub struct TangentParts {
 
 impl TangentParts {
     /// $D^{alg}$ and $L$ of a response.
+    #[inline(always)]
     pub fn new<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Self> {
         let d_alg = law.algorithmic_tangent(&r.trial_strain(), &r.history_n, &r.law_state);
         Ok(Self {
@@ -171,6 +181,7 @@ impl TangentParts {
 
     /// $D$ for continued loading ([`LogStrainLaw::loading_tangent`]) and
     /// $L$ of a response.
+    #[inline(always)]
     pub fn loading<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Self> {
         let d_alg = law.loading_tangent(&r.trial_strain(), &r.history_n, &r.law_state);
         Ok(Self {
@@ -187,11 +198,13 @@ pub trait ConsistentTangent: Send + Sync + 'static {
     fn assemble<H: Copy>(r: &Response<H>, parts: &TangentParts) -> Tensor4;
 
     /// Convenience: the tangent straight from the law and the response.
+    #[inline(always)]
     fn tangent<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Tensor4> {
         Ok(Self::assemble(r, &TangentParts::new(law, r)?))
     }
 
     /// The tangent for continued loading ([`TangentParts::loading`]).
+    #[inline(always)]
     fn loading_tangent<L: LogStrainLaw>(law: &L, r: &Response<L::History>) -> Result<Tensor4> {
         Ok(Self::assemble(r, &TangentParts::loading(law, r)?))
     }

@@ -93,7 +93,7 @@ impl<L: LogStrainLaw> LogStrainLaw for MaterialSet<L> {
 
     const SYMMETRIC_TANGENT: bool = L::SYMMETRIC_TANGENT;
 
-    #[inline]
+    #[inline(always)]
     fn return_map(&self, trial: &SymSpectral, history: &Self::History) -> LawState<Self::History> {
         let state = self.law(history.material).return_map(trial, &history.inner);
         LawState {
@@ -104,7 +104,7 @@ impl<L: LogStrainLaw> LogStrainLaw for MaterialSet<L> {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn algorithmic_tangent(
         &self,
         trial: &SymSpectral,
@@ -115,7 +115,7 @@ impl<L: LogStrainLaw> LogStrainLaw for MaterialSet<L> {
             .algorithmic_tangent(trial, &history.inner, &untagged(state))
     }
 
-    #[inline]
+    #[inline(always)]
     fn loading_tangent(
         &self,
         trial: &SymSpectral,

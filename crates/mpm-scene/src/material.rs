@@ -160,7 +160,7 @@ macro_rules! register_laws {
             const SYMMETRIC_TANGENT: bool =
                 true $(&& <$ty as LogStrainLaw>::SYMMETRIC_TANGENT)+;
 
-            #[inline]
+            #[inline(always)]
             fn return_map(&self, trial: &SymSpectral, history: &SceneHistory) -> LawState<SceneHistory> {
                 match self {
                     $(SceneLaw::$variant(law) => {
@@ -176,7 +176,7 @@ macro_rules! register_laws {
                 }
             }
 
-            #[inline]
+            #[inline(always)]
             fn algorithmic_tangent(
                 &self,
                 trial: &SymSpectral,
@@ -191,7 +191,7 @@ macro_rules! register_laws {
                 }
             }
 
-            #[inline]
+            #[inline(always)]
             fn loading_tangent(
                 &self,
                 trial: &SymSpectral,

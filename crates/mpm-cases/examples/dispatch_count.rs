@@ -1,0 +1,239 @@
+//! One path of the `dispatch` benchmark (`benches/dispatch.rs`) alone, for
+//! instruction counts: sets up the block under gravity, then runs
+//! `ImplicitSolver::assemble_at` `N` times on the typed or the scene
+//! solver, so that a profiler sees one path and nothing of criterion.
+//!
+//! ```text
+//! cargo build --release -p mpm-cases --example dispatch_count
+//! for n in 0 20; do RAYON_NUM_THREADS=1 valgrind --tool=callgrind \
+//!     --callgrind-out-file=cg.$n target/release/examples/dispatch_count \
+//!     2 gimp hencky scene $n; done
+//! callgrind_annotate --inclusive=yes cg.20 | head -40
+//! ```
+//!
+//! Arguments: dimension (`2`, `3`), basis (`linear`, `gimp`), model
+//! (`hencky`, `von_mises`), path (`typed`, `scene`), repetitions (default
+//! 20). Instructions per assembly are the difference of the totals of 20
+//! and 0 repetitions over 20 (the assemblies run on rayon's worker
+//! thread, so `--toggle-collect` on the calling thread misses them).
+//! Prints the last normalised residual (the same bits on both paths).
+//! With 2 points per cell the GIMP domains of this block sit where GIMP
+//! and linear weights coincide, so the GIMP and linear rows assemble the
+//! same stencil and count the same.
+#![allow(missing_docs, clippy::unwrap_used, clippy::print_stdout)]
+
+use std::hint::black_box;
+
+use mpm_basis::{Gimp, LinearMpm};
+use mpm_cases::body::InitialDomain;
+use mpm_cases::material::{SceneLaws, scene_laws};
+use mpm_cases::scene::{self, Problem};
+use mpm_constitutive::{HenckyElastic, LogStrainLaw, Tagged, VonMises};
+use mpm_mesh::RegularGrid;
+use mpm_solver::{
+    AnyGimpRule, DomainUpdater, FBar, GimpRule, ImplicitSolver, MaterialPoints, NoLocking,
+    NoUpdate, Parts, PreviouslyConverged, StretchU,
+};
+
+/// The benchmark's scene: a block under gravity on a regular grid.
+fn scene_text(dim: usize, basis: &str, model: &str) -> String {
+    let (origin, size, cells, lower, upper, g, base) = if dim == 2 {
+        (
+            "[0.0, 0.0]",
+            "[1.0, 1.0]",
+            "[32, 32]",
+            "[0.0, 0.0]",
+            "[1.0, 0.75]",
+            "[0.0, -10.0]",
+            "y_min",
+        )
+    } else {
+        (
+            "[0.0, 0.0, 0.0]",
+            "[1.0, 1.0, 1.0]",
+            "[10, 10, 10]",
+            "[0.0, 0.0, 0.0]",
+            "[1.0, 1.0, 0.7]",
+            "[0.0, 0.0, -10.0]",
+            "z_min",
+        )
+    };
+    let yield_stress = if model == "von_mises" {
+        "yield_stress = 4e3\nhardening = 1e4\n"
+    } else {
+        ""
+    };
+    let rule = if basis == "gimp" { "stretch" } else { "none" };
+    format!(
+        r#"
+[mesh]
+origin = {origin}
+size = {size}
+cells = {cells}
+
+[[material]]
+name = "soil"
+model = "{model}"
+youngs_modulus = 1e6
+poisson_ratio = 0.3
+density = 2000.0
+{yield_stress}
+[[body]]
+name = "block"
+material = "soil"
+region = {{ box = {{ lower = {lower}, upper = {upper} }} }}
+points_per_cell = 2
+
+[[boundary]]
+set = "{base}"
+kind = "fixed"
+
+[[boundary]]
+set = "x_min"
+kind = "roller"
+
+[[boundary]]
+set = "x_max"
+kind = "roller"
+
+[[load]]
+kind = "gravity"
+acceleration = {g}
+
+[solver]
+basis = "{basis}"
+domain_update = "{rule}"
+steps = 1
+"#
+    )
+}
+
+/// The problem's points with histories `history(point)`.
+fn points<const D: usize, B: InitialDomain<D>, H: Copy + Default>(
+    p: &Problem<D>,
+    history: impl Fn(usize) -> H,
+) -> MaterialPoints<D, H, B::Domain> {
+    let domains = (p.position.iter().zip(&p.half_lengths))
+        .map(|(x, l)| B::initial_domain(x, l))
+        .collect();
+    let mut points =
+        MaterialPoints::new(p.position.clone(), p.volume.clone(), 0.0, domains).unwrap();
+    points.mass.clone_from(&p.mass);
+    points.body_force.clone_from(&p.body_force);
+    points.point_force.clone_from(&p.point_forces);
+    for (k, h) in points.history.iter_mut().enumerate() {
+        *h = history(k);
+    }
+    points
+}
+
+/// Sets up one path and runs `reps` assemblies; returns the last residual.
+#[allow(clippy::too_many_arguments)]
+fn run<const D: usize, B, L, U, V>(
+    p: &Problem<D>,
+    basis: B,
+    law: L,
+    typed: U,
+    any: V,
+    scene_path: bool,
+    reps: usize,
+) -> f64
+where
+    B: InitialDomain<D, Mesh = RegularGrid<D>> + Clone,
+    B::Domain: mpm_solver::Flat,
+    L: LogStrainLaw + Clone,
+    U: DomainUpdater<D, B::Domain>,
+    V: DomainUpdater<D, B::Domain>,
+{
+    let grid = match &p.mesh {
+        scene::build::SceneMesh::Grid(g) => g.clone(),
+        scene::build::SceneMesh::Simplex(_) => unreachable!("grid scenes only"),
+    };
+    let increment = |n: usize| -> Vec<f64> {
+        (0..n)
+            .map(|k| 1e-2 * grid.spacing()[0] * ((k * 31 + 7) as f64).sin())
+            .collect()
+    };
+    let mut r = 0.0;
+    if scene_path {
+        let laws: SceneLaws = scene_laws(&[(p.materials[0].model, p.materials[0].params)]).unwrap();
+        let pts = points::<D, B, _>(p, |_| Tagged::new(0, laws.laws()[0].initial_history()));
+        let mut solver: ImplicitSolver<
+            D,
+            Parts<B, PreviouslyConverged, SceneLaws, Option<FBar>, V, _>,
+        > = ImplicitSolver::new(
+            basis,
+            grid.clone(),
+            laws,
+            None,
+            any,
+            p.constraints.clone(),
+            p.newton,
+        );
+        let du = increment(solver.prepare_step(&pts, 0.0, 1.0).unwrap());
+        for _ in 0..reps {
+            r = black_box(solver.assemble_at(&pts, &du).unwrap());
+        }
+    } else {
+        let pts = points::<D, B, L::History>(p, |_| Default::default());
+        let mut solver: ImplicitSolver<D, Parts<B, PreviouslyConverged, L, NoLocking, U, _>> =
+            ImplicitSolver::new(
+                basis,
+                grid.clone(),
+                law,
+                NoLocking,
+                typed,
+                p.constraints.clone(),
+                p.newton,
+            );
+        let du = increment(solver.prepare_step(&pts, 0.0, 1.0).unwrap());
+        for _ in 0..reps {
+            r = black_box(solver.assemble_at(&pts, &du).unwrap());
+        }
+    }
+    r
+}
+
+fn in_dimension<const D: usize>(basis: &str, model: &str, scene_path: bool, reps: usize) -> f64 {
+    let text = scene_text(D, basis, model);
+    let (scene, src) = scene::parse(&text, "dispatch.toml", &[]).unwrap();
+    let p = Problem::<D>::build(&scene, &src, scene.solver.padding()).unwrap();
+    let hencky = HenckyElastic::new(1e6, 0.3).unwrap();
+    let von_mises = VonMises::new(1e6, 0.3, 4e3, 1e4).unwrap();
+    let stretch = AnyGimpRule::new(GimpRule::Stretch);
+    match (basis, model) {
+        ("linear", "hencky") => run(&p, LinearMpm, hencky, NoUpdate, NoUpdate, scene_path, reps),
+        ("linear", "von_mises") => run(
+            &p, LinearMpm, von_mises, NoUpdate, NoUpdate, scene_path, reps,
+        ),
+        ("gimp", "hencky") => run(&p, Gimp, hencky, StretchU, stretch, scene_path, reps),
+        ("gimp", "von_mises") => run(&p, Gimp, von_mises, StretchU, stretch, scene_path, reps),
+        _ => panic!("basis linear|gimp, model hencky|von_mises"),
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let arg = |k: usize, default: &str| args.get(k).cloned().unwrap_or_else(|| default.into());
+    let (dim, basis, model, path) = (
+        arg(0, "2"),
+        arg(1, "gimp"),
+        arg(2, "hencky"),
+        arg(3, "scene"),
+    );
+    let reps: usize = arg(4, "20").parse().unwrap();
+    let scene_path = match path.as_str() {
+        "scene" => true,
+        "typed" => false,
+        _ => panic!("path typed|scene"),
+    };
+    let r = match dim.as_str() {
+        "2" => in_dimension::<2>(&basis, &model, scene_path, reps),
+        "3" => in_dimension::<3>(&basis, &model, scene_path, reps),
+        _ => panic!("dimension 2|3"),
+    };
+    println!(
+        "{dim}d {basis} {model} {path}: residual {r:e} ({:#x})",
+        r.to_bits()
+    );
+}
