@@ -24,12 +24,15 @@ use crate::vane;
 const SOLVERS: [(&str, &str); 4] = [
     ("ours: ILU(0) + BiCGSTAB (faer)", "\"iterative\""),
     (
-        "PETSc: BiCGSTAB + GAMG",
-        "{ petsc = \"-ksp_type bcgs -pc_type gamg\" }",
+        "PETSc: BiCGSTAB + GAMG (interpolation reused in a step)",
+        "{ petsc = \"-ksp_type bcgs -pc_type gamg -pc_gamg_reuse_interpolation true\" }",
     ),
     (
-        "PETSc: GMRES(100) + hypre BoomerAMG",
-        "{ petsc = \"-ksp_type gmres -ksp_gmres_restart 100 -pc_type hypre -pc_hypre_type boomeramg\" }",
+        "PETSc: GMRES(100) + hypre BoomerAMG (3D settings)",
+        "{ petsc = \"-ksp_type gmres -ksp_gmres_restart 100 -pc_type hypre \
+         -pc_hypre_type boomeramg -pc_hypre_boomeramg_strong_threshold 0.7 \
+         -pc_hypre_boomeramg_coarsen_type HMIS -pc_hypre_boomeramg_interp_type ext+i \
+         -pc_hypre_boomeramg_P_max 4 -pc_hypre_boomeramg_agg_nl 1\" }",
     ),
     (
         "PETSc: BiCGSTAB + block Jacobi ILU(0)",
