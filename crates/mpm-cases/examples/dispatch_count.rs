@@ -27,105 +27,17 @@ use std::hint::black_box;
 use mpm_basis::{Gimp, LinearMpm};
 use mpm_cases::body::InitialDomain;
 use mpm_cases::material::{SceneLaws, scene_laws};
-use mpm_cases::scene::{self, Problem};
+use mpm_cases::scene::Problem;
 use mpm_constitutive::{HenckyElastic, LogStrainLaw, Tagged, VonMises};
 use mpm_mesh::RegularGrid;
 use mpm_solver::{
-    AnyGimpRule, DomainUpdater, FBar, GimpRule, ImplicitSolver, MaterialPoints, NoLocking,
-    NoUpdate, Parts, PreviouslyConverged, StretchU,
+    AnyGimpRule, DomainUpdater, FBar, GimpRule, ImplicitSolver, NoLocking, NoUpdate, Parts,
+    PreviouslyConverged, StretchU,
 };
 
-/// The benchmark's scene: a block under gravity on a regular grid.
-fn scene_text(dim: usize, basis: &str, model: &str) -> String {
-    let (origin, size, cells, lower, upper, g, base) = if dim == 2 {
-        (
-            "[0.0, 0.0]",
-            "[1.0, 1.0]",
-            "[32, 32]",
-            "[0.0, 0.0]",
-            "[1.0, 0.75]",
-            "[0.0, -10.0]",
-            "y_min",
-        )
-    } else {
-        (
-            "[0.0, 0.0, 0.0]",
-            "[1.0, 1.0, 1.0]",
-            "[10, 10, 10]",
-            "[0.0, 0.0, 0.0]",
-            "[1.0, 1.0, 0.7]",
-            "[0.0, 0.0, -10.0]",
-            "z_min",
-        )
-    };
-    let yield_stress = if model == "von_mises" {
-        "yield_stress = 4e3\nhardening = 1e4\n"
-    } else {
-        ""
-    };
-    let rule = if basis == "gimp" { "stretch" } else { "none" };
-    format!(
-        r#"
-[mesh]
-origin = {origin}
-size = {size}
-cells = {cells}
-
-[[material]]
-name = "soil"
-model = "{model}"
-youngs_modulus = 1e6
-poisson_ratio = 0.3
-density = 2000.0
-{yield_stress}
-[[body]]
-name = "block"
-material = "soil"
-region = {{ box = {{ lower = {lower}, upper = {upper} }} }}
-points_per_cell = 2
-
-[[boundary]]
-set = "{base}"
-kind = "fixed"
-
-[[boundary]]
-set = "x_min"
-kind = "roller"
-
-[[boundary]]
-set = "x_max"
-kind = "roller"
-
-[[load]]
-kind = "gravity"
-acceleration = {g}
-
-[solver]
-basis = "{basis}"
-domain_update = "{rule}"
-steps = 1
-"#
-    )
-}
-
-/// The problem's points with histories `history(point)`.
-fn points<const D: usize, B: InitialDomain<D>, H: Copy + Default>(
-    p: &Problem<D>,
-    history: impl Fn(usize) -> H,
-) -> MaterialPoints<D, H, B::Domain> {
-    let domains = (p.position.iter().zip(&p.half_lengths))
-        .map(|(x, l)| B::initial_domain(x, l))
-        .collect();
-    let mut points =
-        MaterialPoints::new(p.position.clone(), p.volume.clone(), 0.0, domains).unwrap();
-    points.mass.clone_from(&p.mass);
-    points.body_force.clone_from(&p.body_force);
-    points.point_force.clone_from(&p.point_forces);
-    for (k, h) in points.history.iter_mut().enumerate() {
-        *h = history(k);
-    }
-    points
-}
+#[path = "../benches/dispatch_block/mod.rs"]
+mod block;
+use block::{grid_of, increment, points, problem};
 
 /// Sets up one path and runs `reps` assemblies; returns the last residual.
 #[allow(clippy::too_many_arguments)]
@@ -145,15 +57,8 @@ where
     U: DomainUpdater<D, B::Domain>,
     V: DomainUpdater<D, B::Domain>,
 {
-    let grid = match &p.mesh {
-        scene::build::SceneMesh::Grid(g) => g.clone(),
-        scene::build::SceneMesh::Simplex(_) => unreachable!("grid scenes only"),
-    };
-    let increment = |n: usize| -> Vec<f64> {
-        (0..n)
-            .map(|k| 1e-2 * grid.spacing()[0] * ((k * 31 + 7) as f64).sin())
-            .collect()
-    };
+    let grid = grid_of(p);
+    let h = grid.spacing()[0];
     let mut r = 0.0;
     if scene_path {
         let laws: SceneLaws = scene_laws(&[(p.materials[0].model, p.materials[0].params)]).unwrap();
@@ -170,7 +75,7 @@ where
             p.constraints.clone(),
             p.newton,
         );
-        let du = increment(solver.prepare_step(&pts, 0.0, 1.0).unwrap());
+        let du = increment(solver.prepare_step(&pts, 0.0, 1.0).unwrap(), h);
         for _ in 0..reps {
             r = black_box(solver.assemble_at(&pts, &du).unwrap());
         }
@@ -186,7 +91,7 @@ where
                 p.constraints.clone(),
                 p.newton,
             );
-        let du = increment(solver.prepare_step(&pts, 0.0, 1.0).unwrap());
+        let du = increment(solver.prepare_step(&pts, 0.0, 1.0).unwrap(), h);
         for _ in 0..reps {
             r = black_box(solver.assemble_at(&pts, &du).unwrap());
         }
@@ -195,9 +100,7 @@ where
 }
 
 fn in_dimension<const D: usize>(basis: &str, model: &str, scene_path: bool, reps: usize) -> f64 {
-    let text = scene_text(D, basis, model);
-    let (scene, src) = scene::parse(&text, "dispatch.toml", &[]).unwrap();
-    let p = Problem::<D>::build(&scene, &src, scene.solver.padding()).unwrap();
+    let p = problem::<D>(basis, model);
     let hencky = HenckyElastic::new(1e6, 0.3).unwrap();
     let von_mises = VonMises::new(1e6, 0.3, 4e3, 1e4).unwrap();
     let stretch = AnyGimpRule::new(GimpRule::Stretch);

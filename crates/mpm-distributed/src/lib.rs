@@ -5,8 +5,13 @@
 //!   solver's linear solver ([`mpm_petsc::PetscLinear`]) for scenes with
 //!   `linear = { petsc = "-ksp_type cg -pc_type gamg" }`.
 //!
+//! - always: [`partition`], the ownership of patches (or elements),
+//!   points and nodes over N ranks by METIS, and each rank's halo plan.
+//!
 //! The `mpm` program puts [`external_linear`] in its run control; built
 //! without the feature, a scene asking for PETSc is refused at its key.
+
+pub mod partition;
 
 use mpm_dispatch::linear::ExternalLinear;
 
