@@ -68,8 +68,7 @@ const OUT_DIR: &str = "crates/mpm-cases/tests/reference_values";
 const COMMAND: &str = "cargo run --release -p xtask -- reference-values";
 
 /// The test that reads them.
-const TEST: &str =
-    "crates/mpm-cases/tests/regression.rs (cargo test --release -p mpm-cases --test regression)";
+const TEST: &str = "crates/mpm-cases/tests/regression.rs (cargo test --release -p mpm-cases --test suite regression)";
 
 /// One case's file.
 #[derive(Debug, Serialize)]

@@ -3,7 +3,7 @@
 //! stick out of the grid.
 #![allow(missing_docs)]
 
-mod common;
+use super::common;
 
 use common::*;
 use mpm_basis::{

@@ -4,7 +4,7 @@
 //! the CPDI2 gradient and the derivative of the values.
 #![allow(missing_docs)]
 
-mod common;
+use super::common;
 
 use common::*;
 use mpm_basis::{BasisError, BasisFunction, Corners, Cpdi2, Stencil};

@@ -4,7 +4,7 @@
 //! lines), and continuity across cell faces.
 #![allow(missing_docs)]
 
-mod common;
+use super::common;
 
 use common::*;
 use mpm_basis::{BasisFunction, Corners, Cpdi2, Gimp, LinearMpm, QuadraticBSpline, Stencil};

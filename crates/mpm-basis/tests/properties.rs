@@ -5,7 +5,7 @@
 //! `for_each_node` visiting exactly the evaluated stencil.
 #![allow(missing_docs)]
 
-mod common;
+use super::common;
 
 use common::*;
 use mpm_basis::{

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use super::common;
 
 use common::{mpm, run_outputs as outputs};
 

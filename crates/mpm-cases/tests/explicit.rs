@@ -4,7 +4,7 @@
 //! resumption.
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use common::mpm;
 

@@ -61,8 +61,8 @@
 //!   the overrides of `path.set`, one a line) without catching panics.
 //!
 //! ```sh
-//! cargo test --release -p mpm-cases --test fuzz_scenes -- --nocapture
-//! MPM_FUZZ_BUDGET_SECS=300 cargo test --release -p mpm-cases --test fuzz_scenes -- --nocapture
+//! cargo test --release -p mpm-cases --test suite fuzz_scenes -- --nocapture
+//! MPM_FUZZ_BUDGET_SECS=300 cargo test --release -p mpm-cases --test suite fuzz_scenes -- --nocapture
 //! ```
 //!
 //! Rejections are counted by kind: the [`CasesError`] variant and the

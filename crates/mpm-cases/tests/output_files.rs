@@ -1,7 +1,7 @@
 //! The atomic writer and the series, table and summary files built on it.
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use std::path::Path;
 

@@ -2,7 +2,7 @@
 //! independent XML parser.
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use common::{data_array, dir_entries, element, fresh_dir, parse_xml};
 use mpm_cases::output::OutputError;

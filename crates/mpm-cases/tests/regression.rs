@@ -11,7 +11,7 @@
 //! the move shows in review as a diff of the JSON.
 //!
 //! Run time: 16 s in release on 2 cores (AMD EPYC), build excluded
-//! (`cargo test --release -p mpm-cases --test regression`; the five cases
+//! (`cargo test --release -p mpm-cases --test suite regression`; the five cases
 //! run in parallel on the harness's two threads: column 8.5 s, cantilever
 //! 7.5 s, collapse 10.5 s, annulus 1.4 s, stretch 3.4 s, each slowed by
 //! sharing the cores); 25 to 27 s while another build used the machine.

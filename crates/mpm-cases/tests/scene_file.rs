@@ -2,7 +2,7 @@
 //! that go through the same validation as the file.
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use common::fresh_dir;
 use mpm_cases::scene::SceneError;

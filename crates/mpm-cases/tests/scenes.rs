@@ -3,7 +3,7 @@
 //! mutations of a valid scene, which must never panic.
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use mpm_cases::run::{RunControl, RunOutput};
 use mpm_cases::scene::SceneError;

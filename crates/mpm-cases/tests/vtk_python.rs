@@ -2,12 +2,12 @@
 //! one ParaView uses), through the Python `vtk` package.
 //!
 //! Ignored by default so CI does not depend on Python packages. Run it with
-//! `cargo test -p mpm-cases --release --test vtk_python -- --ignored`, with
+//! `cargo test -p mpm-cases --release --test suite vtk_python -- --ignored`, with
 //! `MPM_VTK_PYTHON` naming a Python that has `vtk` installed (default
 //! `python3`).
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use std::path::Path;
 use std::process::Command;

@@ -36,8 +36,8 @@
 //!   catching panics, to see the backtrace.
 //!
 //! ```sh
-//! cargo test --release -p mpm-mesh --test fuzz_gmsh -- --nocapture
-//! MPM_FUZZ_BUDGET_SECS=300 cargo test --release -p mpm-mesh --test fuzz_gmsh -- --nocapture
+//! cargo test --release -p mpm-mesh --test suite fuzz_gmsh -- --nocapture
+//! MPM_FUZZ_BUDGET_SECS=300 cargo test --release -p mpm-mesh --test suite fuzz_gmsh -- --nocapture
 //! ```
 //!
 //! The rejections are counted by kind (the [`MeshError`] variant; for
@@ -45,7 +45,7 @@
 //! one message each; so are the rejections without a line number.
 #![allow(missing_docs)]
 
-mod fuzz_support;
+use super::fuzz_support;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

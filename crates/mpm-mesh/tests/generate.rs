@@ -5,7 +5,7 @@
 //! nodes at the edge midpoints; bad parameters are typed errors.
 #![allow(missing_docs, clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use common::*;
 use mpm_mesh::{AnnulusMesh, BoxMesh, DiagonalPattern, MeshError, QuadraticMesh, SimplexMesh};

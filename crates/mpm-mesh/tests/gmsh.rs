@@ -3,7 +3,7 @@
 //! it is found.
 #![allow(missing_docs, clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use common::*;
 use mpm_mesh::{GmshElements, GmshMesh, MeshError, parse_msh, read_msh};

@@ -4,7 +4,7 @@
 //! within 1e-9 of the boundary and outside, from random hints.
 #![allow(missing_docs, clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use common::*;
 use mpm_mesh::{AnnulusMesh, MeshError, SimplexMesh, Walk};

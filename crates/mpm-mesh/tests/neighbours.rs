@@ -4,7 +4,7 @@
 //! (its measure is the box's surface or the annulus's perimeter).
 #![allow(missing_docs, clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use std::collections::BTreeMap;
 

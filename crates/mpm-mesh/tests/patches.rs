@@ -3,7 +3,7 @@
 //! its shortest diagonal, and the active elements per patch (Fig. 3B).
 #![allow(missing_docs, clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use common::*;
 use mpm_mesh::{

@@ -7,7 +7,7 @@
 //! formulations give the same solution.
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use mpm_basis::{BasisFunction, Gimp, LinearMpm, LinearSimplex};
 use mpm_constitutive::{HenckyElastic, LogStrainLaw, VonMises};

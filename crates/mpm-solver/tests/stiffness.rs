@@ -3,7 +3,7 @@
 //! mpm-basis, both formulations, elastic and plastic laws, in 2D and 3D.
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use super::common;
 
 use mpm_basis::{BasisFunction, Gimp, LinearMpm, QuadraticBSpline};
 use mpm_constitutive::{HenckyElastic, LogStrainLaw, VonMises};
