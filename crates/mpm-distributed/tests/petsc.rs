@@ -132,3 +132,41 @@ fn unknown_preconditioner_stops_the_run_with_petscs_message() {
     let e = mpm_dispatch::implicit::run(&p, &control(), |_, _, _| Ok(())).unwrap_err();
     assert!(e.to_string().contains("gammg"), "{e}");
 }
+
+/// A misspelt option that PETSc accepts but no object reads stops the run
+/// at the first solve with the option's name, as a configuration error:
+/// no load step is cut for it (a smaller increment cannot help).
+#[test]
+fn unused_option_stops_the_run_without_cutting_a_step() {
+    let p = problem::<2>(
+        "slope.toml",
+        &["solver.linear={ petsc = \"-ksp_type gmres -pc_typ jacobi\" }".to_owned()],
+    );
+    let mut observed = 0;
+    let e = mpm_dispatch::implicit::run(&p, &control(), |_, _, _| {
+        observed += 1;
+        Ok(())
+    })
+    .unwrap_err();
+    // In the first step, with the first load increment (no cut).
+    let first_try = match &e {
+        mpm_solver::SolverError::InStep {
+            step: 0,
+            load_factor,
+            target,
+            source,
+        } if *load_factor == 0.0 && *target == 0.05 => Some(source.as_ref()),
+        _ => None,
+    };
+    assert!(
+        matches!(
+            first_try,
+            Some(mpm_solver::SolverError::LinearConfiguration(
+                mpm_solver::LinearSolveError::Configuration { .. }
+            ))
+        ),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("-pc_typ"), "{e}");
+    assert_eq!(observed, 0, "no step may converge before the error");
+}

@@ -38,9 +38,15 @@ pub enum PetscError {
 
 impl From<PetscError> for mpm_solver::LinearSolveError {
     fn from(e: PetscError) -> Self {
-        Self::Backend {
-            library: "PETSc",
-            message: e.to_string(),
+        match e {
+            PetscError::Unused(_) => Self::Configuration {
+                library: "PETSc",
+                message: e.to_string(),
+            },
+            e => Self::Backend {
+                library: "PETSc",
+                message: e.to_string(),
+            },
         }
     }
 }

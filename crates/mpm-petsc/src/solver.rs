@@ -9,8 +9,9 @@
 //! modes of the free dofs are its near-null space.
 //!
 //! Options no PETSc object read after the first solve are an error
-//! ([`PetscError::Unused`]): a misspelt `-pc_type` must not silently run
-//! another method. A solve that does not converge is
+//! ([`PetscError::Unused`], a [`LinearSolveError::Configuration`], on
+//! which Newton stops at once rather than cut the step): a misspelt
+//! `-pc_type` must not silently run another method. A solve that does not converge is
 //! [`LinearSolveError::NotConverged`] when it reached its iteration limit,
 //! as for the built-in iterative solver, so Newton cuts the step the same
 //! way; another divergence (a breakdown, an indefinite preconditioner) is

@@ -260,7 +260,12 @@ fn iterate<const D: usize>(
     }
     clock
         .time(Stage::Solve, || k.solve())
-        .map_err(|source| retry(StepFailure::LinearSolve { source }, monitor))?;
+        .map_err(|source| match source {
+            LinearSolveError::Configuration { .. } => {
+                StepError::Fatal(SolverError::LinearConfiguration(source))
+            }
+            source => retry(StepFailure::LinearSolve { source }, monitor),
+        })?;
     tally.linear_iterations += k.linear_iterations();
     Ok(None)
 }

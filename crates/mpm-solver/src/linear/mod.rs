@@ -95,6 +95,16 @@ pub enum LinearSolveError {
         /// What it reported.
         message: String,
     },
+    /// The solver cannot be used as configured (e.g. an option that no
+    /// PETSc object read): a smaller increment cannot help, so Newton
+    /// stops at once instead of cutting the step.
+    #[error("{library} is misconfigured: {message}")]
+    Configuration {
+        /// The library.
+        library: &'static str,
+        /// What is wrong.
+        message: String,
+    },
     /// The solution has a non-finite entry: the stiffness is singular or
     /// its values are not finite.
     #[error(
