@@ -9,10 +9,11 @@
 //! [`MaterialPoints::from_flat`]).
 
 use mpm_basis::Corners;
-use mpm_constitutive::{Tagged, VonMisesHistory};
+use mpm_constitutive::{MaterialState, Tagged, VonMisesHistory};
 use nalgebra::{Matrix3, SVector};
 
 use crate::error::SolverError;
+use crate::explicit::VelocityGradient;
 use crate::points::MaterialPoints;
 
 /// A value stored as exactly [`Flat::LEN`] numbers.
@@ -112,6 +113,32 @@ impl<H: Flat> Flat for Tagged<H> {
             u32::MAX
         };
         Tagged::new(material, H::read(&from[1..]))
+    }
+}
+
+/// An explicit law's state: $b^e$, then the law's history.
+impl<H: Flat> Flat for MaterialState<H> {
+    const LEN: usize = 9 + H::LEN;
+    fn write(&self, out: &mut Vec<f64>) {
+        out.extend_from_slice(self.be.as_slice());
+        self.history.write(out);
+    }
+    fn read(from: &[f64]) -> Self {
+        MaterialState {
+            be: Matrix3::from_column_slice(&from[..9]),
+            history: H::read(&from[9..]),
+        }
+    }
+}
+
+/// A Taylor-transfer point's velocity gradient.
+impl<const D: usize> Flat for VelocityGradient<D> {
+    const LEN: usize = D * D;
+    fn write(&self, out: &mut Vec<f64>) {
+        out.extend_from_slice(self.0.as_slice());
+    }
+    fn read(from: &[f64]) -> Self {
+        VelocityGradient(nalgebra::SMatrix::from_column_slice(&from[..D * D]))
     }
 }
 

@@ -129,6 +129,15 @@ pub enum SolverError {
         #[source]
         reason: PointFailure,
     },
+    /// Another rank of a distributed run stopped it (its error, as text),
+    /// or the transport between ranks failed.
+    #[error("rank {rank} stopped the run: {message}")]
+    Rank {
+        /// The rank.
+        rank: usize,
+        /// Its error.
+        message: String,
+    },
     /// A fixed explicit time increment exceeds the stable increment of the
     /// CFL condition (MPoint notes eq. 45) for the current state.
     #[error(
@@ -175,6 +184,10 @@ pub enum SolverError {
     /// solver.
     #[error("analysing the stiffness pattern of the step: {0}")]
     Pattern(#[source] LinearSolveError),
+    /// The linear solver cannot be used as configured
+    /// ([`LinearSolveError::Configuration`]); no step was cut for it.
+    #[error("linear solver: {0}")]
+    LinearConfiguration(#[source] LinearSolveError),
     /// The observer of a run (output, progress) failed; the state after the
     /// last converged step is intact.
     #[error("output or observer after a converged step: {0}")]

@@ -81,6 +81,7 @@ pub mod mesh;
 pub mod moving_mesh;
 pub mod parts;
 pub mod points;
+pub mod ranks;
 pub mod stages;
 pub mod stepping;
 

@@ -11,4 +11,5 @@ mod domain_table2;
 mod explicit;
 mod locking;
 mod moving_mesh;
+mod ranks;
 mod stiffness;

@@ -36,6 +36,8 @@ mod gather;
 pub mod grid;
 pub mod grid_update;
 pub mod mesh;
+pub mod migrate;
+mod on_ranks;
 pub mod options;
 pub mod p2g;
 pub mod points;
@@ -62,7 +64,9 @@ use crate::domain::{DomainUpdater, NoUpdate};
 use crate::error::{PointFailure, SolverError};
 use crate::locking::NoLocking;
 use crate::mesh::NodalMesh;
+use crate::ranks::{self, Reduce};
 use gather::first_error;
+use on_ranks::OnRanks;
 
 /// Points of one grid-to-point task per thread, times this.
 const TASKS_PER_THREAD: usize = 4;
@@ -210,6 +214,8 @@ where
     /// Positions at the start of the step (the averaged path, bases with
     /// domains only).
     position_scratch: Vec<SVector<f64, D>>,
+    /// The other ranks, in a distributed run.
+    on_ranks: Option<OnRanks>,
 }
 
 impl<const D: usize, B, L, T, K> ExplicitSolver<D, B, L, T, K>
@@ -287,6 +293,7 @@ where
             held_stencils: (Vec::new(), Vec::new()),
             domain_rule: NoUpdate,
             position_scratch: Vec::new(),
+            on_ranks: None,
         })
     }
 }
@@ -334,6 +341,7 @@ where
             held_stencils: self.held_stencils,
             domain_rule: rule,
             position_scratch: self.position_scratch,
+            on_ranks: self.on_ranks,
         }
     }
 
@@ -443,19 +451,26 @@ where
         points: &mut PointsOf<D, B, L, T>,
         max_dt: f64,
     ) -> Result<StepInfo, SolverError> {
-        let dt = self.admissible_increment(points, max_dt)?;
-        self.hold_fixed_points(points)?;
+        let admissible = self.admissible_increment(points, max_dt);
+        let dt = self.collective(admissible)?;
+        let held = self.hold_fixed_points(points);
+        self.collective(held)?;
         let mut clock = StageClock::default();
-        clock
+        let scattered = clock
             .time(Stage::P2g, || self.point_to_grid(points))
-            .map_err(|e| self.point_failure(e))?;
-        clock
+            .map_err(|e| self.point_failure(&points.id, e));
+        self.collective(scattered)?;
+        clock.time(Stage::Grid, || self.sum_over_ranks())?;
+        let updated = clock
             .time(Stage::Grid, || self.update_grid(points, dt))
-            .map_err(|e| self.point_failure(e))?;
+            .map_err(|e| self.point_failure(&points.id, e));
+        self.collective(updated)?;
         let work = self.point_force_power(points);
-        let signal = clock
+        let gathered = clock
             .time(Stage::G2p, || self.gather(points, dt))
-            .map_err(|e| self.point_failure(e))?;
+            .map_err(|e| self.point_failure(&points.id, e));
+        let signal = self.collective(gathered)?;
+        let signal = self.reduce(signal, Reduce::Max)?;
         self.move_fixed_points(points, dt);
         clock.add_to(&mut self.stage_times);
         self.external_work += 0.5 * dt * (work + self.point_force_power(points));
@@ -477,6 +492,7 @@ where
         points: &PointsOf<D, B, L, T>,
         max_dt: f64,
     ) -> Result<f64, SolverError> {
+        self.agree_initial_signal(points)?;
         let dt = self.time_increment(points).min(max_dt);
         if !(dt.is_finite() && dt > 0.0) {
             return Err(SolverError::InvalidInput(format!(
@@ -494,23 +510,28 @@ where
                 limit: stable,
             });
         }
-        if points.domain.len() != points.len() || points.domain0.len() != points.len() {
+        if points.domain.len() != points.len()
+            || points.domain0.len() != points.len()
+            || points.id.len() != points.len()
+        {
             return Err(SolverError::InvalidInput(format!(
-                "{} points but {} domains and {} initial domains",
+                "{} points but {} domains, {} initial domains and {} ids",
                 points.len(),
                 points.domain.len(),
-                points.domain0.len()
+                points.domain0.len(),
+                points.id.len()
             )));
         }
         Ok(dt)
     }
 
-    /// The error of a point that failed in the step being taken.
-    fn point_failure(&self, (point, reason): (usize, PointFailure)) -> SolverError {
+    /// The error of a point that failed in the step being taken, named by
+    /// its global id.
+    fn point_failure(&self, id: &[usize], (point, reason): (usize, PointFailure)) -> SolverError {
         SolverError::ExplicitPoint {
             step: self.steps + 1,
             time: self.time,
-            point,
+            point: id.get(point).copied().unwrap_or(point),
             reason,
         }
     }
@@ -564,7 +585,20 @@ where
     /// # Errors
     /// A law without a stored energy.
     pub fn energies(&self, points: &PointsOf<D, B, L, T>) -> Result<Energies, SolverError> {
-        energy::energies(&self.law, &self.options.gravity, points, self.external_work)
+        let local = energy::energies(&self.law, &self.options.gravity, points, self.external_work);
+        let Some(on) = &self.on_ranks else {
+            return local;
+        };
+        let e = ranks::agree(on.ranks.as_ref(), local)?;
+        let mut sums = [e.kinetic, e.strain, e.gravitational, e.external_work];
+        on.ranks.all_reduce(&mut sums, Reduce::Sum)?;
+        let [kinetic, strain, gravitational, external_work] = sums;
+        Ok(Energies {
+            kinetic,
+            strain,
+            gravitational,
+            external_work,
+        })
     }
 
     /// Checks the material-point fixities, sets the fixed velocity
@@ -573,6 +607,12 @@ where
     /// start.
     fn hold_fixed_points(&mut self, points: &mut PointsOf<D, B, L, T>) -> Result<(), SolverError> {
         self.fixed_start.clear();
+        let on_ranks = self.on_ranks.is_some();
+        if on_ranks && !(points.fixed_velocity.is_empty() && points.point_force.is_empty()) {
+            return Err(SolverError::InvalidInput(
+                "point forces and material-point fixities are not yet supported on more than one rank".into(),
+            ));
+        }
         for &(p, c, v) in &points.fixed_velocity {
             if p >= points.len() || c >= D || !v.is_finite() {
                 return Err(SolverError::InvalidInput(format!(

@@ -12,6 +12,9 @@ use crate::error::SolverError;
 /// PIC transfer, nor a basis without domains costs memory per point.
 #[derive(Debug, Clone)]
 pub struct ExplicitPoints<const D: usize, S, T, Dom = ()> {
+    /// Global id of each point: its index on one rank; it travels with the
+    /// point between ranks ([`crate::ranks`]) and names it in errors.
+    pub id: Vec<usize>,
     /// Position $x_p$.
     pub position: Vec<SVector<f64, D>>,
     /// Velocity $v_p$.
@@ -92,6 +95,7 @@ impl<const D: usize, S: Copy + Default, T: Copy + Default> ExplicitPoints<D, S, 
             )));
         }
         Ok(ExplicitPoints {
+            id: self.id,
             position: self.position,
             velocity: self.velocity,
             mass: self.mass,
@@ -133,6 +137,7 @@ impl<const D: usize, S: Copy + Default, T: Copy + Default> ExplicitPoints<D, S, 
             )));
         }
         Ok(Self {
+            id: (0..n).collect(),
             velocity: vec![SVector::zeros(); n],
             mass: volume.iter().map(|v| v * density).collect(),
             volume0: volume.clone(),

@@ -1,0 +1,165 @@
+//! The explicit solver on several ranks ([`crate::ranks`]): each rank
+//! steps the points of its cells; the nodal sums meet over the halo after
+//! the point-to-grid stage, every failure and the stable increment are
+//! decided collectively, and after a step the points that crossed into
+//! another rank's cells move there ([`ExplicitSolver::migrate`]).
+
+use mpm_basis::BasisFunction;
+use mpm_constitutive::IncrementalLaw;
+
+use super::{DilatationTreatment, ExplicitMesh, ExplicitSolver, PointsOf, Transfer, g2p, migrate};
+use crate::checkpoint::Flat;
+use crate::domain::DomainUpdater;
+use crate::error::SolverError;
+use crate::mesh::NodalMesh;
+use crate::ranks::{self, Decomposition, Ranks, Reduce, halo::Halo};
+
+/// A solver's link to the other ranks of a distributed run.
+pub(super) struct OnRanks {
+    pub(super) ranks: Box<dyn Ranks>,
+    layout: Decomposition,
+    halo: Halo,
+    migration: migrate::Migration,
+}
+
+impl<const D: usize, B, L, T, K, R> ExplicitSolver<D, B, L, T, K, R>
+where
+    B: BasisFunction<D>,
+    B::Mesh: ExplicitMesh<D> + NodalMesh<D>,
+    L: IncrementalLaw,
+    T: Transfer<D>,
+    K: DilatationTreatment,
+    R: DomainUpdater<D, B::Domain>,
+{
+    /// The same solver as one rank of a distributed run: it steps the
+    /// points it is given (those of its cells, with their global ids) and
+    /// meets the other ranks through `ranks` as `layout` says.
+    ///
+    /// # Errors
+    /// A decomposition that does not fit the mesh or the ranks; the
+    /// cell-averaged dilatation (its cell sums would need the points of
+    /// other ranks: not yet supported).
+    pub fn on_ranks(
+        mut self,
+        ranks: Box<dyn Ranks>,
+        layout: Decomposition,
+    ) -> Result<Self, SolverError> {
+        layout.check(
+            ranks.rank(),
+            ranks.size(),
+            self.mesh.cell_count(),
+            self.node_count,
+        )?;
+        if K::AVERAGES {
+            return Err(SolverError::InvalidInput(
+                "the cell-averaged dilatation is not yet supported on more than one rank".into(),
+            ));
+        }
+        self.on_ranks = Some(OnRanks {
+            ranks,
+            layout,
+            halo: Halo::default(),
+            migration: migrate::Migration::default(),
+        });
+        Ok(self)
+    }
+
+    /// This rank and the number of ranks ((0, 1) on one).
+    pub fn rank(&self) -> (usize, usize) {
+        self.on_ranks
+            .as_ref()
+            .map_or((0, 1), |on| (on.ranks.rank(), on.ranks.size()))
+    }
+
+    /// A local outcome decided over the ranks ([`ranks::agree`]).
+    pub(super) fn collective<V>(&self, local: Result<V, SolverError>) -> Result<V, SolverError> {
+        match &self.on_ranks {
+            Some(on) => ranks::agree(on.ranks.as_ref(), local),
+            None => local,
+        }
+    }
+
+    /// `value` reduced over the ranks.
+    pub(super) fn reduce(&self, value: f64, op: Reduce) -> Result<f64, SolverError> {
+        let mut v = [value];
+        if let Some(on) = &self.on_ranks {
+            on.ranks.all_reduce(&mut v, op)?;
+        }
+        Ok(v[0])
+    }
+
+    /// The nodal sums over the ranks: the threads' buffers folded into the
+    /// first, then the halo exchange ([`Halo::sum`]). Nothing on one rank.
+    pub(super) fn sum_over_ranks(&mut self) -> Result<(), SolverError> {
+        let Some(on) = &mut self.on_ranks else {
+            return Ok(());
+        };
+        let (first, rest) = self
+            .buffers
+            .split_first_mut()
+            .ok_or_else(|| SolverError::InvalidInput("no grid buffer".into()))?;
+        for b in rest {
+            for i in b.lo..b.hi {
+                let (n, into) = (&b.nodes[i], &mut first.nodes[i]);
+                into.mass += n.mass;
+                into.momentum += n.momentum;
+                into.force += n.force;
+            }
+            first.lo = first.lo.min(b.lo);
+            first.hi = first.hi.max(b.hi);
+            b.clear();
+        }
+        let result = on.halo.sum(on.ranks.as_ref(), &on.layout, first);
+        ranks::agree(on.ranks.as_ref(), result)
+    }
+
+    /// Before the first step: the largest signal speed over all ranks.
+    pub(super) fn agree_initial_signal(
+        &mut self,
+        points: &PointsOf<D, B, L, T>,
+    ) -> Result<(), SolverError> {
+        if self.max_signal.is_some() {
+            return Ok(());
+        }
+        let law = &self.law;
+        let local = (0..points.len())
+            .map(|p| {
+                let m = law.point_p_wave_modulus(&points.material[p]);
+                g2p::signal_speed(m, points.mass[p], points.volume[p], &points.velocity[p])
+            })
+            .fold(0.0, f64::max);
+        self.max_signal = Some(self.reduce(local, Reduce::Max)?);
+        Ok(())
+    }
+}
+
+impl<const D: usize, B, L, T, K, R> ExplicitSolver<D, B, L, T, K, R>
+where
+    B: BasisFunction<D, Domain: Flat>,
+    B::Mesh: ExplicitMesh<D> + NodalMesh<D>,
+    L: IncrementalLaw<State: Flat>,
+    T: Transfer<D, PointState: Flat>,
+    K: DilatationTreatment,
+    R: DomainUpdater<D, B::Domain>,
+{
+    /// After a step of a distributed run: the points that entered another
+    /// rank's cells go there, those entering this rank's arrive (their
+    /// order changes; their global ids stay). Returns (sent, received);
+    /// (0, 0) on one rank.
+    ///
+    /// # Errors
+    /// As [`migrate::Migration::migrate`], decided over the ranks.
+    pub fn migrate(
+        &mut self,
+        points: &mut PointsOf<D, B, L, T>,
+    ) -> Result<(usize, usize), SolverError> {
+        let Some(on) = &mut self.on_ranks else {
+            return Ok((0, 0));
+        };
+        let mesh = &self.mesh;
+        let moved =
+            on.migration
+                .migrate(on.ranks.as_ref(), &on.layout, |x| mesh.cell_of(x), points);
+        ranks::agree(on.ranks.as_ref(), moved)
+    }
+}
