@@ -5,12 +5,17 @@
 //!   solver's linear solver ([`mpm_petsc::PetscLinear`]) for scenes with
 //!   `linear = { petsc = "-ksp_type cg -pc_type gamg" }`.
 //!
+//! - `mpi`: [`mpi_ranks`], MPI processes as the ranks of a distributed
+//!   run (`mpm_solver::ranks`), with an abort-on-panic hook.
+//!
 //! - always: [`partition`], the ownership of patches (or elements),
 //!   points and nodes over N ranks by METIS, and each rank's halo plan.
 //!
 //! The `mpm` program puts [`external_linear`] in its run control; built
 //! without the feature, a scene asking for PETSc is refused at its key.
 
+#[cfg(feature = "mpi")]
+pub mod mpi_ranks;
 pub mod partition;
 
 use mpm_dispatch::linear::ExternalLinear;

@@ -1,0 +1,194 @@
+//! Distributed explicit runs over MPI processes (feature `mpi`): the
+//! colliding disks ([`mpm_solver::ranks::disks`]) under `mpirun -n 1, 2,
+//! 4` equal the one-solver run to rounding; a failure on one rank stops
+//! every rank with the same error; a panic on one rank aborts the job
+//! instead of hanging it. The tests start `mpirun` on this test binary
+//! itself, whose `child_*` tests (ignored unless `MPM_MPI_CHILD` names
+//! them) run on each process.
+#![cfg(feature = "mpi")]
+#![allow(missing_docs, clippy::unwrap_used)]
+
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+use mpm_distributed::mpi_ranks::Mpi;
+use mpm_solver::SolverError;
+use mpm_solver::ranks::disks::{Deal, Disks};
+use mpm_solver::ranks::{Ranks, Reduce};
+
+/// Rounding only (as `mpm-solver`'s `tests/ranks.rs` argues).
+const BOUND: f64 = 1e-12;
+
+/// A job that has not ended in this time hangs.
+const DEADLINE: Duration = Duration::from_secs(120);
+
+/// Runs the child test `name` on `n` processes; the output once it ends.
+fn mpirun(n: usize, name: &str) -> Output {
+    let exe = std::env::current_exe().unwrap();
+    let mut child = Command::new("mpirun")
+        .args(["-n", &n.to_string(), "--oversubscribe"])
+        .arg(&exe)
+        .args([
+            "--exact",
+            name,
+            "--ignored",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env("MPM_MPI_CHILD", name)
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("mpirun (Open MPI) must be installed for the mpi feature's tests");
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > DEADLINE {
+            child.kill().unwrap();
+            panic!("{name} on {n} processes did not end within {DEADLINE:?}");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Whether this process is the child `name` (and not the parent test).
+fn is_child(name: &str) -> bool {
+    std::env::var("MPM_MPI_CHILD").as_deref() == Ok(name)
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+#[test]
+fn disks_on_1_2_4_processes_equal_one_solver() {
+    for n in [1, 2, 4] {
+        let out = mpirun(n, "child_disks");
+        let t = text(&out);
+        assert!(out.status.success(), "{n} processes:\n{t}");
+        // The harness's "test child_disks ... " may precede it.
+        let line = t
+            .lines()
+            .find_map(|l| l.find("disks on").map(|at| &l[at..]))
+            .unwrap_or_else(|| panic!("{t}"));
+        eprintln!("{line}");
+        assert!(line.contains(&format!("disks on {n} processes")), "{line}");
+    }
+}
+
+#[test]
+#[ignore = "run on each process by disks_on_1_2_4_processes_equal_one_solver"]
+fn child_disks() {
+    if !is_child("child_disks") {
+        return;
+    }
+    let mpi = Mpi::init();
+    let ranks = mpi.ranks();
+    let single = Disks::STANDARD.single().unwrap();
+    let mine = Disks::STANDARD
+        .on_ranks(Box::new(ranks), Deal::Scattered)
+        .unwrap();
+    // Every rank compares its own points by id; the worst and the count
+    // are reduced.
+    let mut worst = [0.0f64, 0.0];
+    for (id, x, v) in &mine.points {
+        let (_, xs, vs) = single.points[*id];
+        worst[0] = worst[0].max((x - xs).norm());
+        worst[1] = worst[1].max((v - vs).norm());
+    }
+    let mut counts = [mine.points.len() as f64, mine.migrated as f64];
+    ranks.all_reduce(&mut worst, Reduce::Max).unwrap();
+    ranks.all_reduce(&mut counts, Reduce::Sum).unwrap();
+    assert_eq!(
+        counts[0] as usize,
+        single.points.len(),
+        "every point on exactly one rank"
+    );
+    assert!(worst[0] < BOUND && worst[1] < BOUND, "{worst:?}");
+    assert_eq!(mine.steps, single.steps);
+    assert!(
+        ranks.size() == 1 || counts[1] > 0.0,
+        "the disks must cross between ranks"
+    );
+    if ranks.rank() == 0 {
+        println!(
+            "disks on {} processes: max |Δx| {:.2e} m, |Δv| {:.2e} m/s, {} migrations, {} steps",
+            ranks.size(),
+            worst[0],
+            worst[1],
+            counts[1],
+            mine.steps
+        );
+    }
+}
+
+#[test]
+fn a_failure_on_one_process_stops_all_with_its_error() {
+    let out = mpirun(3, "child_thrown");
+    let t = text(&out);
+    assert!(out.status.success(), "{t}");
+    let reports: Vec<&str> = t
+        .lines()
+        .filter_map(|l| l.find("stopped:").map(|at| &l[at..]))
+        .collect();
+    assert_eq!(reports.len(), 3, "{t}");
+    let typed = reports.iter().filter(|l| l.contains("typed")).count();
+    assert_eq!(typed, 1, "one rank reports the typed error: {reports:?}");
+    let step = |l: &str| {
+        l.split("explicit step ")
+            .nth(1)
+            .map(|r| r.split(' ').next().map(str::to_owned))
+    };
+    let first = step(reports[0]);
+    assert!(
+        first.is_some() && reports.iter().all(|l| step(l) == first),
+        "{reports:?}"
+    );
+}
+
+#[test]
+#[ignore = "run on each process by a_failure_on_one_process_stops_all_with_its_error"]
+fn child_thrown() {
+    if !is_child("child_thrown") {
+        return;
+    }
+    let mpi = Mpi::init();
+    let thrown = Disks {
+        speed: 50.0,
+        ..Disks::STANDARD
+    };
+    match thrown.on_ranks(Box::new(mpi.ranks()), Deal::Scattered) {
+        Err(e @ SolverError::ExplicitPoint { .. }) => println!("stopped: typed {e}"),
+        Err(e @ SolverError::Rank { .. }) => println!("stopped: {e}"),
+        other => panic!("expected the point to leave the grid: {other:?}"),
+    }
+}
+
+#[test]
+fn a_panic_on_one_process_aborts_the_job() {
+    let out = mpirun(2, "child_panic");
+    assert!(!out.status.success(), "{}", text(&out));
+}
+
+#[test]
+#[ignore = "run on each process by a_panic_on_one_process_aborts_the_job"]
+fn child_panic() {
+    if !is_child("child_panic") {
+        return;
+    }
+    let mpi = Mpi::init();
+    let ranks = mpi.ranks();
+    if ranks.rank() == 1 {
+        panic!("rank 1 fails");
+    }
+    // Rank 0 waits for rank 1 for ever unless the hook aborts the job.
+    let mut v = [0.0];
+    ranks.all_reduce(&mut v, Reduce::Sum).unwrap();
+}
