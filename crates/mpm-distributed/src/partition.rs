@@ -18,6 +18,8 @@
 //! in ascending global order on both sides, so one message per neighbour
 //! carries them all.
 
+use mpm_solver::SolverError;
+use mpm_solver::ranks::Decomposition;
 use thiserror::Error;
 
 /// Why a partition could not be made.
@@ -249,6 +251,29 @@ fn metis_kway(
 }
 
 impl Partition {
+    /// Rank `rank`'s [`Decomposition`] for the explicit solver on several
+    /// ranks (`mpm_solver::ranks`): the elements' ranks, the nodes' owners
+    /// (as here) and the neighbours within `reach` rings of its elements
+    /// (1 for linear shape functions, 2 for GIMP and quadratic B-splines).
+    ///
+    /// # Errors
+    /// A mesh that does not fit the partition.
+    pub fn decomposition(
+        &self,
+        mesh: &MeshView<'_>,
+        rank: usize,
+        reach: usize,
+    ) -> Result<Decomposition, SolverError> {
+        Decomposition::from_cells(
+            rank,
+            self.rank_of_element.clone(),
+            mesh.connectivity,
+            mesh.nodes_per_element,
+            mesh.nodes,
+            reach,
+        )
+    }
+
     /// Rank `rank`'s halo plan on `mesh` (module docs).
     pub fn halo_plan(&self, mesh: &MeshView<'_>, rank: usize) -> HaloPlan {
         let touches = self.ranks_touching_nodes(mesh);

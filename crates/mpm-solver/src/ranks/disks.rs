@@ -65,7 +65,11 @@ impl Disks {
         end: 4.0,
     };
 
-    fn grid(&self) -> Result<RegularGrid<2>, SolverError> {
+    /// The background grid: the unit square and one cell of padding.
+    ///
+    /// # Errors
+    /// An invalid cell count.
+    pub fn grid(&self) -> Result<RegularGrid<2>, SolverError> {
         let h = 1.0 / self.cells as f64;
         Ok(RegularGrid::new(
             Vector2::new(-h, -h),
@@ -129,15 +133,42 @@ impl Disks {
         })
     }
 
+    /// The grid's connectivity (four nodes per cell) and the cell of
+    /// every point at the start, for a partitioner.
+    ///
+    /// # Errors
+    /// The set-up's.
+    pub fn cells(&self) -> Result<(Vec<usize>, Vec<usize>), SolverError> {
+        let grid = self.grid()?;
+        let points = self.points()?;
+        let of_points = (0..points.len())
+            .map(|p| cell_of(&grid, &points.position[p]))
+            .collect::<Result<_, _>>()?;
+        Ok((connectivity(&grid)?, of_points))
+    }
+
     /// This rank's part of the run on `ranks`, the cells dealt by `deal`:
     /// step, then migrate, until the end.
     ///
     /// # Errors
     /// The set-up's or the solver's, decided over the ranks.
     pub fn on_ranks(&self, ranks: Box<dyn Ranks>, deal: Deal) -> Result<Outcome, SolverError> {
+        let cells = dealt(&self.grid()?, ranks.size(), deal)?;
+        self.on_cells(ranks, cells)
+    }
+
+    /// As [`Self::on_ranks`] with the rank of every cell given (e.g. by
+    /// METIS).
+    ///
+    /// # Errors
+    /// The set-up's or the solver's, decided over the ranks.
+    pub fn on_cells(
+        &self,
+        ranks: Box<dyn Ranks>,
+        cells: Vec<usize>,
+    ) -> Result<Outcome, SolverError> {
         let grid = self.grid()?;
-        let (rank, size) = (ranks.rank(), ranks.size());
-        let cells = dealt(&grid, size, deal)?;
+        let rank = ranks.rank();
         let mut points = share(&self.points()?, &grid, &cells, rank)?;
         let connectivity = connectivity(&grid)?;
         let layout =
