@@ -23,7 +23,7 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, criterion_group};
 use mpm_basis::{Gimp, LinearMpm};
 use mpm_cases::body::InitialDomain;
 use mpm_cases::material::{SceneLaws, scene_laws};
@@ -324,4 +324,15 @@ fn explicit_cube(c: &mut Criterion) {
 }
 
 criterion_group!(benches, dispatch, where_it_goes, explicit_cube);
-criterion_main!(benches);
+
+/// Criterion's main, or with `--count` one path for a profiler
+/// ([`block::count`]).
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("--count") {
+        block::count::main(&args[1..]);
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

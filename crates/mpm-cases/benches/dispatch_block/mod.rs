@@ -1,9 +1,11 @@
-//! The block under gravity of the `dispatch` benchmark, shared with the
-//! `dispatch_count` example (instruction counts of one path): its scene,
+//! The block under gravity of the `dispatch` benchmark, shared with its
+//! `--count` mode ([`count`], instruction counts of one path): its scene,
 //! its problem, points with given histories, its grid and a deterministic
 //! increment. Included by `#[path]` (a file directly in `benches/` would be
 //! a benchmark of its own).
 #![allow(dead_code, clippy::unwrap_used)]
+
+pub mod count;
 
 use mpm_cases::body::InitialDomain;
 use mpm_cases::scene::{self, Problem};

@@ -1,13 +1,15 @@
-//! One path of the `dispatch` benchmark (`benches/dispatch.rs`) alone, for
-//! instruction counts: sets up the block under gravity, then runs
-//! `ImplicitSolver::assemble_at` `N` times on the typed or the scene
-//! solver, so that a profiler sees one path and nothing of criterion.
+//! One path of the `dispatch` benchmark alone, for instruction counts:
+//! the benchmark binary run with `--count` sets up the block under
+//! gravity, then runs `ImplicitSolver::assemble_at` `N` times on the typed
+//! or the scene solver, so that a profiler sees one path and nothing of
+//! criterion. (A mode of the benchmark, not an example: `cargo test`
+//! builds every example, and this one cost 35 s of the test build.)
 //!
 //! ```text
-//! cargo build --release -p mpm-cases --example dispatch_count
+//! cargo bench -p mpm-cases --bench dispatch --no-run   # prints the binary
 //! for n in 0 20; do RAYON_NUM_THREADS=1 valgrind --tool=callgrind \
-//!     --callgrind-out-file=cg.$n target/release/examples/dispatch_count \
-//!     2 gimp hencky scene $n; done
+//!     --callgrind-out-file=cg.$n target/release/deps/dispatch-HASH \
+//!     --count 2 gimp hencky scene $n; done
 //! callgrind_annotate --inclusive=yes cg.20 | head -40
 //! ```
 //!
@@ -20,7 +22,6 @@
 //! With 2 points per cell the GIMP domains of this block sit where GIMP
 //! and linear weights coincide, so the GIMP and linear rows assemble the
 //! same stencil and count the same.
-#![allow(missing_docs, clippy::unwrap_used, clippy::print_stdout)]
 
 use std::hint::black_box;
 
@@ -35,9 +36,7 @@ use mpm_solver::{
     PreviouslyConverged, StretchU,
 };
 
-#[path = "../benches/dispatch_block/mod.rs"]
-mod block;
-use block::{grid_of, increment, points, problem};
+use super::{grid_of, increment, points, problem};
 
 /// Sets up one path and runs `reps` assemblies; returns the last residual.
 #[allow(clippy::too_many_arguments)]
@@ -115,8 +114,8 @@ fn in_dimension<const D: usize>(basis: &str, model: &str, scene_path: bool, reps
     }
 }
 
-fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+/// Runs the path `args` names (module docs) and prints its residual.
+pub fn main(args: &[String]) {
     let arg = |k: usize, default: &str| args.get(k).cloned().unwrap_or_else(|| default.into());
     let (dim, basis, model, path) = (
         arg(0, "2"),
