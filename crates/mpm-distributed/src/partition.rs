@@ -236,6 +236,13 @@ fn metis_kway(
     ranks: usize,
 ) -> Result<(Vec<usize>, usize), PartitionError> {
     let metis_error = |e: &dyn std::fmt::Display| PartitionError::Metis(e.to_string());
+    // METIS 5 keeps process-wide state (its error handling's jump buffers,
+    // its memory accounting): two threads partitioning at once hung here
+    // (four thread ranks repartitioning together). One call at a time.
+    static METIS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one_at_a_time = METIS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let nparts = metis::Idx::try_from(ranks).map_err(|e| metis_error(&e))?;
     let mut part = vec![0 as metis::Idx; xadj.len() - 1];
     let cut = metis::Graph::new(1, nparts, xadj, adjncy)

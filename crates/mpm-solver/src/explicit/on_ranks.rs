@@ -162,4 +162,56 @@ where
                 .migrate(on.ranks.as_ref(), &on.layout, |x| mesh.cell_of(x), points);
         ranks::agree(on.ranks.as_ref(), moved)
     }
+
+    /// The number of points in every cell over all ranks (the same on
+    /// every rank): the loads a partitioner balances
+    /// ([`Self::rebalance`]). Empty on one rank.
+    ///
+    /// # Errors
+    /// The transport's.
+    pub fn cell_loads(&self, points: &PointsOf<D, B, L, T>) -> Result<Vec<f64>, SolverError> {
+        let Some(on) = &self.on_ranks else {
+            return Ok(Vec::new());
+        };
+        let mut loads = vec![0.0; self.mesh.cell_count()];
+        for x in &points.position {
+            if let Some(c) = self.mesh.cell_of(x) {
+                loads[c] += 1.0;
+            }
+        }
+        on.ranks.all_reduce(&mut loads, Reduce::Sum)?;
+        Ok(loads)
+    }
+
+    /// A new decomposition for a run under way (the same on every rank,
+    /// e.g. METIS on [`Self::cell_loads`]): every point whose cell now
+    /// belongs to another rank goes there, from any rank to any (it may be
+    /// a neighbour in neither decomposition), then the run goes on with
+    /// `layout`. Returns (sent, received); (0, 0) on one rank.
+    ///
+    /// # Errors
+    /// A decomposition that does not fit; the transport's; decided over
+    /// the ranks.
+    pub fn rebalance(
+        &mut self,
+        points: &mut PointsOf<D, B, L, T>,
+        mut layout: Decomposition,
+    ) -> Result<(usize, usize), SolverError> {
+        let Some(on) = &mut self.on_ranks else {
+            return Ok((0, 0));
+        };
+        let (rank, size) = (on.ranks.rank(), on.ranks.size());
+        let fits = layout.check(rank, size, self.mesh.cell_count(), self.node_count);
+        ranks::agree(on.ranks.as_ref(), fits)?;
+        let everyone = (0..size).filter(|&q| q != rank).collect();
+        let neighbours = std::mem::replace(&mut layout.neighbours, everyone);
+        let mesh = &self.mesh;
+        let moved = on
+            .migration
+            .migrate(on.ranks.as_ref(), &layout, |x| mesh.cell_of(x), points);
+        let moved = ranks::agree(on.ranks.as_ref(), moved)?;
+        layout.neighbours = neighbours;
+        on.layout = layout;
+        Ok(moved)
+    }
 }

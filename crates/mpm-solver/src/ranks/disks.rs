@@ -43,6 +43,9 @@ pub struct Disks {
     pub end: f64,
 }
 
+/// Deals the cells to the ranks anew from the points per cell.
+pub type Repartition<'a> = dyn Fn(&[f64]) -> Result<Vec<usize>, SolverError> + 'a;
+
 /// What a run ends with on one rank.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outcome {
@@ -52,8 +55,10 @@ pub struct Outcome {
     pub energies: (f64, f64),
     /// Steps taken.
     pub steps: usize,
-    /// Points this rank sent to others.
+    /// Points this rank sent to others after steps.
     pub migrated: usize,
+    /// Points this rank sent to others when the cells were dealt anew.
+    pub rebalanced: usize,
 }
 
 impl Disks {
@@ -130,6 +135,7 @@ impl Disks {
             energies: (e.kinetic, e.strain),
             steps: s.steps(),
             migrated: 0,
+            rebalanced: 0,
         })
     }
 
@@ -167,17 +173,41 @@ impl Disks {
         ranks: Box<dyn Ranks>,
         cells: Vec<usize>,
     ) -> Result<Outcome, SolverError> {
+        self.rebalanced(ranks, cells, usize::MAX, &|_| unreachable_repartition())
+    }
+
+    /// As [`Self::on_cells`], the cells dealt anew every `every` steps by
+    /// `repartition` from the points per cell
+    /// ([`crate::explicit::ExplicitSolver::cell_loads`]; it must give every
+    /// rank the same answer) and the points moved there
+    /// ([`crate::explicit::ExplicitSolver::rebalance`]). The points moved
+    /// by those count in [`Outcome::rebalanced`].
+    ///
+    /// # Errors
+    /// The set-up's, the partitioner's or the solver's, decided over the
+    /// ranks.
+    pub fn rebalanced(
+        &self,
+        ranks: Box<dyn Ranks>,
+        cells: Vec<usize>,
+        every: usize,
+        repartition: &Repartition<'_>,
+    ) -> Result<Outcome, SolverError> {
         let grid = self.grid()?;
         let rank = ranks.rank();
         let mut points = share(&self.points()?, &grid, &cells, rank)?;
         let connectivity = connectivity(&grid)?;
-        let layout =
-            Decomposition::from_cells(rank, cells, &connectivity, 4, grid.node_count(), 2)?;
-        let mut s = self.solver()?.on_ranks(ranks, layout)?;
-        let mut migrated = 0;
+        let decompose =
+            |cells| Decomposition::from_cells(rank, cells, &connectivity, 4, grid.node_count(), 2);
+        let mut s = self.solver()?.on_ranks(ranks, decompose(cells)?)?;
+        let (mut migrated, mut rebalanced) = (0, 0);
         while s.time() < self.end * (1.0 - 1e-12) {
             s.step(&mut points, self.end - s.time())?;
             migrated += s.migrate(&mut points)?.0;
+            if s.steps() % every == 0 {
+                let cells = repartition(&s.cell_loads(&points)?)?;
+                rebalanced += s.rebalance(&mut points, decompose(cells)?)?.0;
+            }
         }
         let e = s.energies(&points)?;
         Ok(Outcome {
@@ -185,8 +215,16 @@ impl Disks {
             energies: (e.kinetic, e.strain),
             steps: s.steps(),
             migrated,
+            rebalanced,
         })
     }
+}
+
+/// The repartition of a run that never repartitions.
+fn unreachable_repartition() -> Result<Vec<usize>, SolverError> {
+    Err(SolverError::InvalidInput(
+        "no repartition was asked for".into(),
+    ))
 }
 
 /// The largest distance in position and in velocity between the points

@@ -14,6 +14,9 @@ use super::{RankError, Ranks, Reduce};
 enum Kind {
     PointToPoint = 0,
     Collective = 1,
+    /// The sender's rank has ended (returned or panicked): a rank waiting
+    /// for more from it gets an error instead of waiting for ever.
+    Stopped = 2,
 }
 
 /// One message: sender, kind, payload.
@@ -25,6 +28,7 @@ type Message = (usize, Kind, Vec<f64>);
 struct Inbox {
     receiver: Receiver<Message>,
     pending: [Vec<VecDeque<Vec<f64>>>; 2],
+    stopped: Vec<bool>,
 }
 
 /// One rank of a group of threads ([`ThreadRanks::group`]).
@@ -49,6 +53,7 @@ impl ThreadRanks {
                 inbox: Mutex::new(Inbox {
                     receiver,
                     pending: [vec![VecDeque::new(); size], vec![VecDeque::new(); size]],
+                    stopped: vec![false; size],
                 }),
             })
             .collect()
@@ -100,12 +105,32 @@ impl ThreadRanks {
             {
                 return Ok(data);
             }
+            if inbox.stopped.get(from).copied().unwrap_or(true) {
+                return Err(self.error(format!("rank {from} has stopped")));
+            }
             let (sender, k, data) = inbox
                 .receiver
                 .recv()
                 .map_err(|_| self.error(format!("rank {from} has stopped")))?;
-            if let Some(queue) = inbox.pending[k as usize].get_mut(sender) {
+            if k == Kind::Stopped {
+                if let Some(s) = inbox.stopped.get_mut(sender) {
+                    *s = true;
+                }
+            } else if let Some(queue) = inbox.pending[k as usize].get_mut(sender) {
                 queue.push_back(data);
+            }
+        }
+    }
+}
+
+/// A rank that ends tells every other, so none waits for it for ever (a
+/// panic on one thread rank fails the others' next exchange with it).
+impl Drop for ThreadRanks {
+    fn drop(&mut self) {
+        for (q, sender) in self.senders.iter().enumerate() {
+            if q != self.rank {
+                // A rank that has ended already needs no word.
+                let _ = sender.send((self.rank, Kind::Stopped, Vec::new()));
             }
         }
     }
@@ -213,6 +238,22 @@ mod tests {
                 assert_eq!(got, vec![(10 * q + me) as f64]);
             }
         }
+    }
+
+    #[test]
+    fn a_panicking_rank_fails_the_others_instead_of_hanging_them() {
+        let out = std::panic::catch_unwind(|| {
+            ThreadRanks::run(3, |r| {
+                if r.rank() == 1 {
+                    panic!("rank 1 fails");
+                }
+                let mut v = [1.0];
+                r.all_reduce(&mut v, Reduce::Sum)
+            })
+        });
+        // The run re-raises rank 1's panic once the others have returned
+        // (with an error): it ends.
+        assert!(out.is_err());
     }
 
     #[test]
