@@ -425,16 +425,21 @@ where
     /// points' current state (from the last step's grid-to-point stage, or
     /// computed from the points before the first step).
     pub fn stable_increment(&mut self, points: &PointsOf<D, B, L, T>) -> f64 {
-        let law = &self.law;
-        let signal = *self.max_signal.get_or_insert_with(|| {
-            (0..points.len())
-                .map(|p| {
-                    let m = law.point_p_wave_modulus(&points.material[p]);
-                    g2p::signal_speed(m, points.mass[p], points.volume[p], &points.velocity[p])
-                })
-                .fold(0.0, f64::max)
-        });
+        let signal = match self.max_signal {
+            Some(s) => s,
+            None => *self.max_signal.insert(self.local_signal(points)),
+        };
         self.mesh.min_spacing() / signal
+    }
+
+    /// The largest signal speed $c_p + \|v_p\|$ of this solver's points.
+    fn local_signal(&self, points: &PointsOf<D, B, L, T>) -> f64 {
+        (0..points.len())
+            .map(|p| {
+                let m = self.law.point_p_wave_modulus(&points.material[p]);
+                g2p::signal_speed(m, points.mass[p], points.volume[p], &points.velocity[p])
+            })
+            .fold(0.0, f64::max)
     }
 
     /// Advances the points by one step of at most `max_dt`.

@@ -7,7 +7,7 @@
 use mpm_basis::BasisFunction;
 use mpm_constitutive::IncrementalLaw;
 
-use super::{DilatationTreatment, ExplicitMesh, ExplicitSolver, PointsOf, Transfer, g2p, migrate};
+use super::{DilatationTreatment, ExplicitMesh, ExplicitSolver, PointsOf, Transfer, migrate};
 use crate::checkpoint::Flat;
 use crate::domain::DomainUpdater;
 use crate::error::SolverError;
@@ -121,13 +121,7 @@ where
         if self.max_signal.is_some() {
             return Ok(());
         }
-        let law = &self.law;
-        let local = (0..points.len())
-            .map(|p| {
-                let m = law.point_p_wave_modulus(&points.material[p]);
-                g2p::signal_speed(m, points.mass[p], points.volume[p], &points.velocity[p])
-            })
-            .fold(0.0, f64::max);
+        let local = self.local_signal(points);
         self.max_signal = Some(self.reduce(local, Reduce::Max)?);
         Ok(())
     }
