@@ -65,6 +65,18 @@ pub enum StepFailure {
         #[from]
         source: LinearSolveError,
     },
+    /// In a distributed run, another rank's points failed (its failure,
+    /// as text): every rank takes the same branch, and `backtrack` says
+    /// whether that failure lets Newton halve its correction.
+    #[error("rank {rank}: {message}")]
+    OnRank {
+        /// The lowest failing rank (or the rank whose transport failed).
+        rank: usize,
+        /// Its failure.
+        message: String,
+        /// Whether halving the correction may cure it.
+        backtrack: bool,
+    },
 }
 
 /// Everything that can stop a simulation.

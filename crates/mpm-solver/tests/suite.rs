@@ -9,6 +9,7 @@ mod common;
 mod bspline_boundary;
 mod domain_table2;
 mod explicit;
+mod implicit_ranks;
 mod locking;
 mod moving_mesh;
 mod ranks;

@@ -65,7 +65,7 @@ pub trait NewtonStages<const D: usize> {
     fn update_tangents(&mut self, norms: bool) -> Result<(), StepFailure>;
     /// The rounding-noise level of the residual, from the first
     /// iteration's tangents.
-    fn rounding_noise(&self) -> f64;
+    fn rounding_noise(&mut self) -> f64;
     /// Stage 4d: the stiffness.
     fn assemble_stiffness(&mut self);
     /// Stage 4e: the linear solve.
@@ -77,6 +77,10 @@ pub trait NewtonStages<const D: usize> {
     /// Stage 5: the converged state, the mesh at `lambda1` and the
     /// predictor's memory of the load increment `dlambda`.
     fn commit(&mut self, lambda1: f64, dlambda: f64) -> Result<(), SolverError>;
+    /// On several ranks, a failure of the transport in a stage that could
+    /// not return it (a reduction of the forces or the stiffness); read
+    /// before their numbers are used.
+    fn rank_failure(&mut self) -> Option<SolverError>;
 }
 
 /// A stage of the load step, as [`StageTimes`] reports it.
@@ -235,6 +239,9 @@ fn iterate<const D: usize>(
     } else {
         clock.time(Stage::Force, || k.assemble_internal_force());
     }
+    if let Some(e) = k.rank_failure() {
+        return Err(StepError::Fatal(e));
+    }
     let (f_int, f_ext) = k.forces();
     if first {
         tally.initial_unbalance = convergence::unbalance_all_dofs(f_int, f_ext);
@@ -292,7 +299,7 @@ impl<const D: usize, P: SolverParts<D>> NewtonStages<D> for Bound<'_, D, P> {
         self.solver.begin_constraints(self.points);
         self.solver.build_system(self.points, lambda0, lambda1)?;
         self.solver.assemble_external_force(self.points, lambda1);
-        Ok(())
+        self.rank_failure().map_or(Ok(()), Err)
     }
 
     fn predict(&mut self, dlambda: f64) -> bool {
@@ -348,12 +355,8 @@ impl<const D: usize, P: SolverParts<D>> NewtonStages<D> for Bound<'_, D, P> {
         self.solver.update_tangents_with(self.points, false, norms)
     }
 
-    fn rounding_noise(&self) -> f64 {
-        convergence::rounding_noise(
-            &self.solver.system,
-            self.solver.force_gradients(),
-            &self.solver.it.tangent_norms,
-        )
+    fn rounding_noise(&mut self) -> f64 {
+        self.solver.rounding_noise()
     }
 
     fn assemble_stiffness(&mut self) {
@@ -370,6 +373,10 @@ impl<const D: usize, P: SolverParts<D>> NewtonStages<D> for Bound<'_, D, P> {
 
     fn factorisation(&self) -> Option<crate::linear::Factorisation> {
         self.solver.linear.last_factorisation()
+    }
+
+    fn rank_failure(&mut self) -> Option<SolverError> {
+        self.solver.ranks.as_mut()?.take_failure()
     }
 
     fn commit(&mut self, lambda1: f64, dlambda: f64) -> Result<(), SolverError> {

@@ -41,6 +41,7 @@
 
 pub mod builder;
 pub mod driver;
+mod on_ranks;
 pub mod options;
 mod predictor;
 pub mod report;
@@ -148,6 +149,8 @@ pub struct ImplicitSolver<const D: usize, P: SolverParts<D>> {
     /// the last step; walking on unstructured meshes, Wang et al. 2021
     /// Algorithm 1); `usize::MAX` when unknown.
     hints: Vec<usize>,
+    /// The other ranks of a distributed run ([`Self::on_ranks`]).
+    ranks: Option<on_ranks::RankLink>,
 }
 
 impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
@@ -182,7 +185,27 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             previous: None,
             first_iterate_converged: false,
             hints: Vec::new(),
+            ranks: None,
         }
+    }
+
+    /// Runs this solver as one rank of a distributed run: its points are
+    /// this rank's, the mesh and the constraints every rank's
+    /// (`on_ranks`'s module docs: the system of each step is the same on
+    /// every rank, rank 0 solves it). Every rank must call the same
+    /// methods with the same load factors. The ghost penalty is refused
+    /// at the first step (its face terms belong to no rank's points), and
+    /// a patch of a coupled locking treatment must hold the points of one
+    /// rank only.
+    pub fn on_ranks(&mut self, ranks: Box<dyn crate::ranks::Ranks>) {
+        self.ranks = Some(on_ranks::RankLink::new(ranks));
+    }
+
+    /// This rank and the number of ranks ((0, 1) on one).
+    pub fn rank(&self) -> (usize, usize) {
+        self.ranks
+            .as_ref()
+            .map_or((0, 1), on_ranks::RankLink::rank_and_size)
     }
 
     /// Replaces the linear solver (the default is the one

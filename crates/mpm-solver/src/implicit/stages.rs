@@ -10,6 +10,7 @@ use nalgebra::{Matrix3, SVector};
 use rayon::iter::Either;
 use rayon::prelude::*;
 
+use super::on_ranks::{self, RankLink};
 use super::{ImplicitSolver, MAX_BACKTRACKS};
 use crate::boundary::{Constraints, StepView};
 use crate::error::{SolverError, StepFailure};
@@ -22,7 +23,7 @@ use crate::parts::{PointsOf, SolverParts};
 use crate::stages::gather::PointStress;
 use crate::stages::patch::PatchSystem;
 use crate::stages::system::{NONE, StepSystem};
-use crate::stages::{basis, gather, update as grid_to_point};
+use crate::stages::{basis, convergence, gather, update as grid_to_point};
 
 /// $\epsilon$ of the forward difference in
 /// [`ImplicitSolver::linearised_start`]: small enough that points
@@ -152,14 +153,49 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// Stage 1: basis values and gradients of every point at the start of
     /// the step ([`crate::stages::basis::evaluate`]).
     pub fn evaluate_basis(&mut self, points: &PointsOf<D, P>) -> Result<(), SolverError> {
-        basis::evaluate(
+        let local = basis::evaluate(
             &self.basis,
             &self.mesh,
             &points.position,
             &points.domain,
             &mut self.hints,
             &mut self.system,
-        )
+        );
+        self.agree(local)
+    }
+
+    /// A local outcome decided over the ranks (itself on one).
+    fn agree(&self, local: Result<(), SolverError>) -> Result<(), SolverError> {
+        match &self.ranks {
+            Some(link) => link.agree(local),
+            None => local,
+        }
+    }
+
+    /// A local failure of an iterate decided over the ranks (itself on
+    /// one).
+    fn agree_step(&mut self, local: Result<(), StepFailure>) -> Result<(), StepFailure> {
+        match &mut self.ranks {
+            Some(link) => link.agree_step(local),
+            None => local,
+        }
+    }
+
+    /// Replaces `values` by their sum over the ranks (nothing on one).
+    fn sum_over_ranks(ranks: &mut Option<RankLink>, values: &mut [f64]) {
+        if let Some(link) = ranks {
+            link.sum(values);
+        }
+    }
+
+    /// The rounding-noise level of the residual from the last tangent
+    /// pass's norms ([`convergence::rounding_noise`]), its node bounds
+    /// summed over the ranks.
+    pub(super) fn rounding_noise(&mut self) -> f64 {
+        let mut bounds =
+            convergence::node_bounds(&self.system, self.force_gradients(), &self.it.tangent_norms);
+        Self::sum_over_ranks(&mut self.ranks, &mut bounds);
+        convergence::noise_of_bounds(&self.system, &bounds)
     }
 
     /// Stage 2: active nodes, dofs, prescribed increments, adjacency, the
@@ -171,81 +207,11 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         lambda0: f64,
         lambda1: f64,
     ) -> Result<(), SolverError> {
-        let node_count = self.mesh.node_count();
-        let volumes = &points.volume;
+        self.number_active_nodes();
+        self.build_ghost(points)?;
+        self.build_neighbours(points)?;
+        let weak = self.weak_nodes(&points.volume);
         let sys = &mut self.system;
-        sys.number_nodes(node_count);
-        sys.build_adjacency();
-        let ghost = &mut self.ghost;
-        if self.options.ghost.is_on() {
-            let grid = self
-                .mesh
-                .regular_grid()
-                .ok_or(SolverError::Ghost("it is defined on regular grids only"))?;
-            // Each point's shear modulus: its material's under a law of
-            // several materials.
-            let law = &self.law;
-            let history = &points.history;
-            if history.iter().any(|h| law.point_shear_modulus(h).is_none()) {
-                return Err(SolverError::Ghost(
-                    "it scales with the law's shear modulus, and this law gives none",
-                ));
-            }
-            let g = self.options.ghost;
-            if !(g.factor.is_finite() && g.fill > 0.0 && g.fill <= 1.0) {
-                return Err(SolverError::Ghost(
-                    "its factor must be finite and its fill in (0, 1]",
-                ));
-            }
-            ghost.build(
-                grid,
-                &points.position,
-                volumes,
-                sys,
-                |p| g.factor * 2.0 * law.point_shear_modulus(&history[p]).unwrap_or(0.0),
-                g.fill,
-            )?;
-        } else {
-            ghost.clear();
-        }
-        let ghost = &self.ghost;
-        if self.locking.couples_points() {
-            let input = PatchInput {
-                position: &points.position,
-                cells: &self.hints,
-                volume: volumes,
-            };
-            self.locking
-                .assign(&self.mesh, input, &mut self.patches.assignment)?;
-            self.patches.build(sys);
-            let patches = &self.patches;
-            sys.build_neighbours_from(|w, push| patches.neighbours(w, push));
-        } else {
-            sys.build_neighbours();
-        }
-        if !ghost.is_empty() {
-            sys.extend_neighbours(|w, push| ghost.partners(w, push));
-        }
-        if self.locking.couples_points() {
-            self.patches.build_placement(sys);
-        }
-        let (support, stiffness) = gather::support_weights(sys, volumes);
-        let max = |x: &[f64]| x.iter().copied().fold(0.0, f64::max);
-        let (support_cut, stiffness_cut) = (
-            self.options.weak_node_threshold * max(&support),
-            self.options.weak_node_stiffness * max(&stiffness),
-        );
-        // The support rule holds a node whose value *and* gradient vanish
-        // at its points (a fringe node of a domain or a spline); a node
-        // whose value vanishes but whose gradient does not (the node of a
-        // linear cell or simplex opposite a point on an edge) shapes the
-        // points' strains and stays free.
-        let support_stiffness_cut = self.options.weak_node_threshold * max(&stiffness);
-        let weak: Vec<bool> = support
-            .iter()
-            .zip(&stiffness)
-            .map(|(&s, &k)| (s < support_cut && k < support_stiffness_cut) || k < stiffness_cut)
-            .collect();
         let constraints = &self.constraints;
         let active_of_mesh = std::mem::take(&mut sys.active_of_mesh);
         sys.build_pattern(|node, i| {
@@ -292,10 +258,128 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         Ok(())
     }
 
+    /// The active nodes of the step: those any rank's points touch.
+    fn number_active_nodes(&mut self) {
+        let node_count = self.mesh.node_count();
+        let sys = &mut self.system;
+        match &mut self.ranks {
+            Some(link) => sys.number_nodes_with(node_count, |marks| link.unite_nodes(marks)),
+            None => sys.number_nodes(node_count),
+        }
+        sys.build_adjacency();
+    }
+
+    /// The faces of the ghost penalty, when it is on.
+    fn build_ghost(&mut self, points: &PointsOf<D, P>) -> Result<(), SolverError> {
+        let ghost = &mut self.ghost;
+        if !self.options.ghost.is_on() {
+            ghost.clear();
+            return Ok(());
+        }
+        if self.ranks.is_some() {
+            return Err(SolverError::Ghost(
+                "its face terms belong to no rank's points: it is not available on several ranks",
+            ));
+        }
+        let grid = self
+            .mesh
+            .regular_grid()
+            .ok_or(SolverError::Ghost("it is defined on regular grids only"))?;
+        // Each point's shear modulus: its material's under a law of
+        // several materials.
+        let law = &self.law;
+        let history = &points.history;
+        if history.iter().any(|h| law.point_shear_modulus(h).is_none()) {
+            return Err(SolverError::Ghost(
+                "it scales with the law's shear modulus, and this law gives none",
+            ));
+        }
+        let g = self.options.ghost;
+        if !(g.factor.is_finite() && g.fill > 0.0 && g.fill <= 1.0) {
+            return Err(SolverError::Ghost(
+                "its factor must be finite and its fill in (0, 1]",
+            ));
+        }
+        ghost.build(
+            grid,
+            &points.position,
+            &points.volume,
+            &self.system,
+            |p| g.factor * 2.0 * law.point_shear_modulus(&history[p]).unwrap_or(0.0),
+            g.fill,
+        )?;
+        Ok(())
+    }
+
+    /// The neighbour lists of the pattern: the points' stencils, widened
+    /// by the patches of a coupled locking treatment and the ghost faces,
+    /// united over the ranks.
+    fn build_neighbours(&mut self, points: &PointsOf<D, P>) -> Result<(), SolverError> {
+        if self.locking.couples_points() {
+            let input = PatchInput {
+                position: &points.position,
+                cells: &self.hints,
+                volume: &points.volume,
+            };
+            let assigned = self
+                .locking
+                .assign(&self.mesh, input, &mut self.patches.assignment)
+                .map_err(SolverError::from);
+            self.agree(assigned)?;
+            if let Some(link) = &mut self.ranks {
+                link.check_patches(&self.patches.assignment)?;
+            }
+            self.patches.build(&self.system);
+            let patches = &self.patches;
+            self.system
+                .build_neighbours_from(|w, push| patches.neighbours(w, push));
+        } else {
+            self.system.build_neighbours();
+        }
+        let sys = &mut self.system;
+        if let Some(link) = &mut self.ranks {
+            let (nb_ptr, nb) = (std::mem::take(&mut sys.nb_ptr), std::mem::take(&mut sys.nb));
+            link.unite_neighbours(&nb_ptr, &nb, |all| sys.build_neighbours_from(all));
+        }
+        let ghost = &self.ghost;
+        if !ghost.is_empty() {
+            sys.extend_neighbours(|w, push| ghost.partners(w, push));
+        }
+        if self.locking.couples_points() {
+            self.patches.build_placement(sys);
+        }
+        Ok(())
+    }
+
+    /// The weak-node rule per active node: its support weights summed
+    /// over the ranks' points.
+    fn weak_nodes(&mut self, volumes: &[f64]) -> Vec<bool> {
+        let (mut support, mut stiffness) = gather::support_weights(&self.system, volumes);
+        Self::sum_over_ranks(&mut self.ranks, &mut support);
+        Self::sum_over_ranks(&mut self.ranks, &mut stiffness);
+        let max = |x: &[f64]| x.iter().copied().fold(0.0, f64::max);
+        let (support_cut, stiffness_cut) = (
+            self.options.weak_node_threshold * max(&support),
+            self.options.weak_node_stiffness * max(&stiffness),
+        );
+        // The support rule holds a node whose value *and* gradient vanish
+        // at its points (a fringe node of a domain or a spline); a node
+        // whose value vanishes but whose gradient does not (the node of a
+        // linear cell or simplex opposite a point on an edge) shapes the
+        // points' strains and stays free.
+        let support_stiffness_cut = self.options.weak_node_threshold * max(&stiffness);
+        support
+            .iter()
+            .zip(&stiffness)
+            .map(|(&s, &k)| (s < support_cut && k < support_stiffness_cut) || k < stiffness_cut)
+            .collect()
+    }
+
     /// Stage 3: the external force of the step
     /// ([`crate::stages::gather::external_force`]), constant over the step.
     pub fn assemble_external_force(&mut self, points: &PointsOf<D, P>, lambda1: f64) {
         gather::external_force(&self.system, points, lambda1, &mut self.it.f_ext);
+        Self::sum_over_ranks(&mut self.ranks, &mut self.it.f_ext);
     }
 
     /// Stage 4a with backtracking: when a Newton correction inverts a
@@ -320,9 +404,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         };
         let mut result = update(self);
         let mut backtracks = 0;
-        while let Err(StepFailure::Constitutive { .. } | StepFailure::ExcessiveIncrement { .. }) =
-            result
-        {
+        while result.as_ref().is_err_and(on_ranks::backtracks) {
             if !after_solve || backtracks == MAX_BACKTRACKS {
                 break;
             }
@@ -386,6 +468,16 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// The pass over points of stage 4a, with the tangents of stage 4c
     /// instead of the stored responses when `TANGENTS`.
     fn material_pass<const TANGENTS: bool>(
+        &mut self,
+        points: &PointsOf<D, P>,
+        norms: bool,
+    ) -> Result<(), StepFailure> {
+        let local = self.material_pass_here::<TANGENTS>(points, norms);
+        self.agree_step(local)
+    }
+
+    /// [`Self::material_pass`] over this rank's points alone.
+    fn material_pass_here<const TANGENTS: bool>(
         &mut self,
         points: &PointsOf<D, P>,
         norms: bool,
@@ -526,6 +618,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         if !self.ghost.is_empty() {
             self.ghost.add_force::<D>(&self.it.du, &mut f_int);
         }
+        Self::sum_over_ranks(&mut self.ranks, &mut f_int);
         self.it.f_int = f_int;
     }
 
@@ -557,6 +650,18 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             // After the fused pass or a failed update.
             self.material_pass::<false>(points, false)?;
         }
+        let local = self.tangents_here(points, loading, norms);
+        self.agree_step(local)
+    }
+
+    /// The tangents of [`Self::update_tangents_with`] over this rank's
+    /// points, from their current responses.
+    fn tangents_here(
+        &mut self,
+        points: &PointsOf<D, P>,
+        loading: bool,
+        norms: bool,
+    ) -> Result<(), StepFailure> {
         let coupled = self.locking.couples_points();
         let (law, alpha) = (&self.law, &self.patches.alpha);
         let it = &mut self.it;
@@ -716,6 +821,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         if !self.ghost.is_empty() {
             self.ghost.add_stiffness(&self.system, &mut values);
         }
+        Self::sum_over_ranks(&mut self.ranks, &mut values);
         self.it.values = values;
         self.it.stiffness_assembled = true;
     }
@@ -744,6 +850,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             self.ghost.add_force::<D>(&self.it.du, &mut f_int);
             self.ghost.add_stiffness(&self.system, &mut values);
         }
+        Self::sum_over_ranks(&mut self.ranks, &mut f_int);
+        Self::sum_over_ranks(&mut self.ranks, &mut values);
         self.it.f_int = f_int;
         self.it.values = values;
         self.it.stiffness_assembled = true;
@@ -764,7 +872,12 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                 it.rhs[free as usize] = it.f_ext[dof] - it.f_int[dof];
             }
         }
-        self.linear.solve(&it.values, &mut it.rhs)?;
+        match &mut self.ranks {
+            Some(link) => link.solve_on_root(self.linear.as_mut(), &it.values, &mut it.rhs)?,
+            None => {
+                self.linear.solve(&it.values, &mut it.rhs)?;
+            }
+        }
         for (dof, &free) in sys.free_of_dof.iter().enumerate() {
             if free != NONE {
                 it.du[dof] += it.rhs[free as usize];
@@ -783,14 +896,15 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             self.material_pass::<false>(points, false)
                 .map_err(|cause| SolverError::Commit { cause })?;
         }
-        grid_to_point::commit(
+        let local = grid_to_point::commit(
             &self.system,
             &self.it.du,
             &self.mesh,
             &self.updater,
             &self.it.responses,
             points,
-        )
+        );
+        self.agree(local)
     }
 
     /// The view [`Constraints::begin_step`] receives.

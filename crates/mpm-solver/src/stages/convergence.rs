@@ -112,12 +112,27 @@ pub fn rounding_noise<const D: usize>(
     grads: &[SVector<f64, D>],
     tangent_norms: &[f64],
 ) -> f64 {
+    noise_of_bounds(sys, &node_bounds(sys, grads, tangent_norms))
+}
+
+/// Per active node, $\sum_p \|T_p\|_F\,\|\nabla S_{vp}\|$ over the points
+/// at hand (on several ranks, each rank's part of the sum).
+pub fn node_bounds<const D: usize>(
+    sys: &StepSystem<D>,
+    grads: &[SVector<f64, D>],
+    tangent_norms: &[f64],
+) -> Vec<f64> {
     let mut bound = vec![0.0; sys.n_active()];
     for (p, &norm) in tangent_norms.iter().enumerate() {
         for s in sys.slots(p) {
             bound[sys.nodes[s] as usize] += norm * grads[s].norm();
         }
     }
+    bound
+}
+
+/// [`rounding_noise`] from the whole sums of [`node_bounds`].
+pub fn noise_of_bounds<const D: usize>(sys: &StepSystem<D>, bound: &[f64]) -> f64 {
     let b2: f64 = sys
         .free_of_dof
         .iter()

@@ -107,6 +107,13 @@ impl<const D: usize> StepSystem<D> {
     /// Marks the active nodes, numbers them by ascending mesh id and
     /// rewrites the stencils in active numbering.
     pub fn number_nodes(&mut self, node_count: usize) {
+        self.number_nodes_with(node_count, |_| {});
+    }
+
+    /// [`Self::number_nodes`], with `unite` seeing the marks (0 for a
+    /// node the points touch, [`NONE`] otherwise) before the numbering:
+    /// on several ranks, it adds the nodes the other ranks' points touch.
+    pub fn number_nodes_with(&mut self, node_count: usize, unite: impl FnOnce(&mut [u32])) {
         self.active_of_mesh.clear();
         self.active_of_mesh.resize(node_count, NONE);
         for p in 0..self.counts.len() {
@@ -114,6 +121,7 @@ impl<const D: usize> StepSystem<D> {
                 self.active_of_mesh[self.nodes[s] as usize] = 0;
             }
         }
+        unite(&mut self.active_of_mesh);
         self.active.clear();
         for (mesh_id, slot) in self.active_of_mesh.iter_mut().enumerate() {
             if *slot != NONE {

@@ -1,0 +1,318 @@
+//! The implicit solver on several ranks ([`crate::ranks`]): each rank holds
+//! its own material points and the whole mesh; the system of a load step
+//! is the same on every rank.
+//!
+//! - **Active nodes and dofs**: the union of the nodes every rank's points
+//!   touch (a reduction of the mesh's node marks), numbered by ascending
+//!   mesh id as on one rank, so every rank has the same free dofs.
+//! - **Pattern**: the union of the ranks' neighbour lists (one exchange
+//!   per load step), so the sparsity pattern is the same everywhere.
+//! - **Sums over points** (internal and external force, the stiffness
+//!   values, the support weights of the weak-node rule and the rounding
+//!   noise bounds): each rank sums its points, then one reduction adds the
+//!   ranks' sums.
+//! - **Linear solve**: on rank 0 with the solver the options name, its
+//!   solution (or its failure) sent to every rank, so every rank holds the
+//!   same increment.
+//! - **Decisions**: the residual is reduced before the convergence test,
+//!   and every failure of a rank's points (a constitutive update, a basis
+//!   evaluation, the commit) is decided together ([`RankLink::agree_step`],
+//!   [`crate::ranks::agree`]): every rank backtracks, cuts the step or
+//!   stops at the same point, with the lowest failing rank's error.
+//!
+//! One rank is the single solver bit for bit (no reduction changes a
+//! number). On N ranks only the order of the additions over points
+//! changes. What this replicates (the nodal vectors and the matrix values
+//! on every rank, one rank solving) suits a machine's worth of ranks, not
+//! hundreds; a linear solver that takes each rank's part of the matrix
+//! (PETSc's parallel AIJ) is the step after it (docs/src/guide/distributed.md).
+
+use crate::error::{SolverError, StepFailure};
+use crate::linear::{LinearSolveError, LinearSolver};
+use crate::locking::PatchAssignment;
+use crate::ranks::{self, RankError, Ranks, Reduce};
+use crate::stages::system::NONE;
+
+/// The implicit solver's link to the other ranks of a distributed run.
+pub(super) struct RankLink {
+    ranks: Box<dyn Ranks>,
+    /// The first transport failure of a stage that cannot return it (the
+    /// driver reads it before it uses the stage's result).
+    failure: Option<SolverError>,
+}
+
+impl std::fmt::Debug for RankLink {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RankLink")
+            .field("rank", &self.ranks.rank())
+            .field("size", &self.ranks.size())
+            .field("failure", &self.failure)
+            .finish()
+    }
+}
+
+/// Whether a failure of a Newton iterate is one that halving the
+/// correction may cure ([`super::MAX_BACKTRACKS`]).
+pub(super) fn backtracks(f: &StepFailure) -> bool {
+    matches!(
+        f,
+        StepFailure::Constitutive { .. }
+            | StepFailure::ExcessiveIncrement { .. }
+            | StepFailure::OnRank {
+                backtrack: true,
+                ..
+            }
+    )
+}
+
+/// What rank 0's linear solve ended with, as sent to the other ranks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum SolveCode {
+    Solved = 0,
+    /// A failure a smaller increment may cure.
+    Failed = 1,
+    /// [`LinearSolveError::Configuration`]: fatal.
+    Misconfigured = 2,
+}
+
+impl RankLink {
+    /// A link through `ranks`.
+    pub(super) fn new(ranks: Box<dyn Ranks>) -> Self {
+        Self {
+            ranks,
+            failure: None,
+        }
+    }
+
+    /// This rank and the number of ranks.
+    pub(super) fn rank_and_size(&self) -> (usize, usize) {
+        (self.ranks.rank(), self.ranks.size())
+    }
+
+    /// The first transport failure since the last call, if any.
+    pub(super) fn take_failure(&mut self) -> Option<SolverError> {
+        self.failure.take()
+    }
+
+    fn record(&mut self, result: Result<(), RankError>) {
+        if let Err(e) = result {
+            self.failure.get_or_insert(e.into());
+        }
+    }
+
+    /// Replaces `values` by their sum over the ranks.
+    pub(super) fn sum(&mut self, values: &mut [f64]) {
+        if self.ranks.size() > 1 {
+            let result = self.ranks.all_reduce(values, Reduce::Sum);
+            self.record(result);
+        }
+    }
+
+    /// A local outcome decided over the ranks ([`ranks::agree`]).
+    pub(super) fn agree(&self, local: Result<(), SolverError>) -> Result<(), SolverError> {
+        ranks::agree(self.ranks.as_ref(), local)
+    }
+
+    /// A local failure of a Newton iterate decided over the ranks: when
+    /// any rank failed, the lowest failing rank returns its own failure
+    /// and every other rank [`StepFailure::OnRank`] with its message and
+    /// whether it backtracks, so that all ranks take the same branch.
+    pub(super) fn agree_step(&mut self, local: Result<(), StepFailure>) -> Result<(), StepFailure> {
+        let me = self.ranks.rank();
+        let mut failing = [if local.is_err() {
+            me as f64
+        } else {
+            f64::INFINITY
+        }];
+        if let Err(e) = self.ranks.all_reduce(&mut failing, Reduce::Min) {
+            return Err(StepFailure::OnRank {
+                rank: e.rank,
+                message: e.message,
+                backtrack: false,
+            });
+        }
+        if failing[0].is_infinite() {
+            return local;
+        }
+        let root = failing[0] as usize;
+        // The first character says whether the failure backtracks.
+        let mut text = match &local {
+            Err(f) if me == root => format!("{}{f}", if backtracks(f) { 'b' } else { 'f' }),
+            _ => String::new(),
+        };
+        if let Err(e) = self.ranks.broadcast_text(root, &mut text) {
+            return Err(StepFailure::OnRank {
+                rank: e.rank,
+                message: e.message,
+                backtrack: false,
+            });
+        }
+        if me == root {
+            return local;
+        }
+        let backtrack = text.starts_with('b');
+        Err(StepFailure::OnRank {
+            rank: root,
+            message: text.get(1..).unwrap_or_default().to_owned(),
+            backtrack,
+        })
+    }
+
+    /// Marks the nodes any rank's points touch: `marks` holds 0 for a
+    /// node this rank touches and [`NONE`] otherwise, on entry and exit.
+    pub(super) fn unite_nodes(&mut self, marks: &mut [u32]) {
+        if self.ranks.size() == 1 {
+            return;
+        }
+        let mut touched: Vec<f64> = marks.iter().map(|&m| f64::from(m == 0)).collect();
+        let result = self.ranks.all_reduce(&mut touched, Reduce::Max);
+        self.record(result);
+        for (m, &t) in marks.iter_mut().zip(&touched) {
+            *m = if t > 0.0 { 0 } else { NONE };
+        }
+    }
+
+    /// The union over the ranks of the neighbour lists `nb_ptr`/`nb` (CSR
+    /// over the active nodes): every rank sends its lists to every other
+    /// one. `rebuild` receives a function that pushes node `w`'s
+    /// neighbours from every rank (the caller sorts and deduplicates).
+    pub(super) fn unite_neighbours(
+        &mut self,
+        nb_ptr: &[usize],
+        nb: &[u32],
+        rebuild: impl FnOnce(&dyn Fn(usize, &mut dyn FnMut(u32))),
+    ) {
+        let (me, size) = self.rank_and_size();
+        let others: Vec<usize> = (0..size).filter(|&q| q != me).collect();
+        // Per node with neighbours: its id, their count, then them.
+        let mut mine = Vec::with_capacity(nb.len() + 2 * nb_ptr.len());
+        for w in 0..nb_ptr.len().saturating_sub(1) {
+            let list = &nb[nb_ptr[w]..nb_ptr[w + 1]];
+            if !list.is_empty() {
+                mine.push(w as f64);
+                mine.push(list.len() as f64);
+                mine.extend(list.iter().map(|&v| f64::from(v)));
+            }
+        }
+        let outgoing = vec![mine; others.len()];
+        let mut incoming = vec![Vec::new(); others.len()];
+        let result = self.ranks.exchange(&others, &outgoing, &mut incoming);
+        self.record(result);
+        let n = nb_ptr.len().saturating_sub(1);
+        let mut received: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for message in &incoming {
+            let mut k = 0;
+            while k + 1 < message.len() {
+                let (w, count) = (message[k] as usize, message[k + 1] as usize);
+                let list = message.get(k + 2..k + 2 + count).unwrap_or_default();
+                if let Some(into) = received.get_mut(w) {
+                    into.extend(list.iter().map(|&v| v as u32));
+                }
+                k += 2 + count;
+            }
+        }
+        rebuild(&|w, push| {
+            nb[nb_ptr[w]..nb_ptr[w + 1]]
+                .iter()
+                .chain(&received[w])
+                .for_each(|&v| push(v));
+        });
+    }
+
+    /// Checks that no patch of a coupled locking treatment holds points
+    /// of two ranks (its average would miss the other rank's points).
+    ///
+    /// # Errors
+    /// [`SolverError::InvalidInput`] naming the patch and two of its ranks.
+    pub(super) fn check_patches(
+        &mut self,
+        assignment: &PatchAssignment,
+    ) -> Result<(), SolverError> {
+        let me = self.ranks.rank() as f64;
+        let mut count = [assignment
+            .patch
+            .iter()
+            .map(|&q| q as f64 + 1.0)
+            .fold(0.0, f64::max)];
+        self.ranks.all_reduce(&mut count, Reduce::Max)?;
+        let n = count[0] as usize;
+        let mut lowest = vec![f64::INFINITY; n];
+        let mut highest = vec![f64::NEG_INFINITY; n];
+        for &q in &assignment.patch {
+            lowest[q as usize] = me;
+            highest[q as usize] = me;
+        }
+        self.ranks.all_reduce(&mut lowest, Reduce::Min)?;
+        self.ranks.all_reduce(&mut highest, Reduce::Max)?;
+        match (0..n).find(|&q| lowest[q] < highest[q]) {
+            None => Ok(()),
+            Some(q) => Err(SolverError::InvalidInput(format!(
+                "patch {q} of the locking treatment holds points of ranks {} and {}: the \
+                 points of a patch must live on one rank",
+                lowest[q], highest[q]
+            ))),
+        }
+    }
+
+    /// Solves on rank 0 and sends the solution, or the failure, to every
+    /// rank: on return `rhs` holds the same numbers on every rank.
+    ///
+    /// # Errors
+    /// Rank 0's own error there; elsewhere a [`LinearSolveError::Backend`]
+    /// (or [`LinearSolveError::Configuration`] when rank 0's was one)
+    /// carrying its message.
+    pub(super) fn solve_on_root(
+        &mut self,
+        linear: &mut dyn LinearSolver,
+        values: &[f64],
+        rhs: &mut [f64],
+    ) -> Result<(), LinearSolveError> {
+        if self.ranks.size() == 1 {
+            return linear.solve(values, rhs).map(|_| ());
+        }
+        let root = self.ranks.rank() == 0;
+        let mut local = Ok(());
+        let mut code = [SolveCode::Solved as u8 as f64];
+        if root {
+            local = linear.solve(values, rhs).map(|_| ());
+            if let Err(e) = &local {
+                rhs.fill(0.0);
+                code[0] = f64::from(match e {
+                    LinearSolveError::Configuration { .. } => SolveCode::Misconfigured as u8,
+                    _ => SolveCode::Failed as u8,
+                });
+            }
+        } else {
+            rhs.fill(0.0);
+        }
+        let transport = |e: RankError| LinearSolveError::Backend {
+            library: "rank transport",
+            message: e.to_string(),
+        };
+        self.ranks
+            .all_reduce(&mut code, Reduce::Max)
+            .map_err(transport)?;
+        if code[0] == SolveCode::Solved as u8 as f64 {
+            // Zeros elsewhere: the sum is rank 0's solution exactly.
+            return self.ranks.all_reduce(rhs, Reduce::Sum).map_err(transport);
+        }
+        let mut text = match &local {
+            Err(e) => e.to_string(),
+            Ok(()) => String::new(),
+        };
+        self.ranks.broadcast_text(0, &mut text).map_err(transport)?;
+        match local {
+            Err(e) => Err(e),
+            Ok(()) if code[0] == SolveCode::Misconfigured as u8 as f64 => {
+                Err(LinearSolveError::Configuration {
+                    library: "rank 0's linear solver",
+                    message: text,
+                })
+            }
+            Ok(()) => Err(LinearSolveError::Backend {
+                library: "rank 0's linear solver",
+                message: text,
+            }),
+        }
+    }
+}
