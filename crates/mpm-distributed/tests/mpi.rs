@@ -1,8 +1,10 @@
-//! Distributed explicit runs over MPI processes (feature `mpi`): the
-//! colliding disks ([`mpm_solver::ranks::disks`]) under `mpirun -n 1, 2,
-//! 4` equal the one-solver run to rounding; a failure on one rank stops
-//! every rank with the same error; a panic on one rank aborts the job
-//! instead of hanging it. The tests start `mpirun` on this test binary
+//! Distributed runs over MPI processes (feature `mpi`): the colliding
+//! disks ([`mpm_solver::ranks::disks`], explicit) and the strip-loaded von
+//! Mises block ([`mpm_solver::ranks::strip_load`], implicit, with and
+//! without F-bar) under `mpirun -n 1, 2, 4` equal the one-solver run to
+//! rounding (one process bit for bit for the block); a failure on one rank
+//! stops every rank with the same error, in either solver; a panic on one
+//! rank aborts the job instead of hanging it. The tests start `mpirun` on this test binary
 //! itself, whose `child_*` tests (ignored unless `MPM_MPI_CHILD` names
 //! them) run on each process.
 #![cfg(feature = "mpi")]
@@ -12,8 +14,10 @@ use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
 use mpm_distributed::mpi_ranks::Mpi;
+use mpm_solver::NewtonOptions;
 use mpm_solver::SolverError;
 use mpm_solver::ranks::disks::{Deal, Disks};
+use mpm_solver::ranks::strip_load::{self, Treatment};
 use mpm_solver::ranks::{Ranks, Reduce};
 
 /// Rounding only (as `mpm-solver`'s `tests/ranks.rs` argues).
@@ -129,24 +133,32 @@ fn child_disks() {
     }
 }
 
-#[test]
-fn a_failure_on_one_process_stops_all_with_its_error() {
-    let out = mpirun(3, "child_thrown");
+/// Runs the child `name` on `n` processes, each of which prints how it
+/// stopped: the job ends normally and exactly one process reports the
+/// typed error. The `n` reports.
+fn stop_reports(n: usize, name: &str) -> Vec<String> {
+    let out = mpirun(n, name);
     let t = text(&out);
     assert!(out.status.success(), "{t}");
-    let reports: Vec<&str> = t
+    let reports: Vec<String> = t
         .lines()
-        .filter_map(|l| l.find("stopped:").map(|at| &l[at..]))
+        .filter_map(|l| l.find("stopped:").map(|at| l[at..].to_owned()))
         .collect();
-    assert_eq!(reports.len(), 3, "{t}");
+    assert_eq!(reports.len(), n, "{t}");
     let typed = reports.iter().filter(|l| l.contains("typed")).count();
     assert_eq!(typed, 1, "one rank reports the typed error: {reports:?}");
+    reports
+}
+
+#[test]
+fn a_failure_on_one_process_stops_all_with_its_error() {
+    let reports = stop_reports(3, "child_thrown");
     let step = |l: &str| {
         l.split("explicit step ")
             .nth(1)
             .map(|r| r.split(' ').next().map(str::to_owned))
     };
-    let first = step(reports[0]);
+    let first = step(&reports[0]);
     assert!(
         first.is_some() && reports.iter().all(|l| step(l) == first),
         "{reports:?}"
@@ -191,4 +203,98 @@ fn child_panic() {
     // Rank 0 waits for rank 1 for ever unless the hook aborts the job.
     let mut v = [0.0];
     ranks.all_reduce(&mut v, Reduce::Sum).unwrap();
+}
+
+#[test]
+fn strip_load_on_1_2_4_processes_equals_one_solver() {
+    for n in [1, 2, 4] {
+        let out = mpirun(n, "child_strip_load");
+        let t = text(&out);
+        assert!(out.status.success(), "{n} processes:\n{t}");
+        let lines: Vec<&str> = t
+            .lines()
+            .filter_map(|l| l.find("strip load").map(|at| &l[at..]))
+            .collect();
+        lines.iter().for_each(|l| eprintln!("{l}"));
+        assert_eq!(lines.len(), 2, "{t}");
+        assert!(
+            lines
+                .iter()
+                .all(|l| l.contains(&format!("on {n} processes")))
+        );
+    }
+}
+
+#[test]
+#[ignore = "run on each process by strip_load_on_1_2_4_processes_equals_one_solver"]
+fn child_strip_load() {
+    if !is_child("child_strip_load") {
+        return;
+    }
+    let mpi = Mpi::init();
+    let ranks = mpi.ranks();
+    let tolerance = NewtonOptions::default().tolerance;
+    for treatment in [Treatment::Standard, Treatment::FBar] {
+        let single = strip_load::single(treatment).unwrap();
+        let mine =
+            strip_load::on_ranks(Box::new(ranks), treatment, strip_load::Deal::Cells).unwrap();
+        if ranks.size() == 1 {
+            assert_eq!(mine, single, "one process is the single solver bit for bit");
+        }
+        let d = strip_load::differences(&single, &mine);
+        let mut worst = [d.displacement, d.stress, d.reaction];
+        let mut count = [mine.ids.len() as f64];
+        ranks.all_reduce(&mut worst, Reduce::Max).unwrap();
+        ranks.all_reduce(&mut count, Reduce::Sum).unwrap();
+        assert_eq!(
+            count[0] as usize,
+            single.ids.len(),
+            "every point on one rank"
+        );
+        let iterations =
+            |o: &strip_load::Outcome| -> Vec<usize> { o.residuals.iter().map(Vec::len).collect() };
+        assert_eq!(iterations(&mine), iterations(&single));
+        assert!(worst[0] <= 10.0 * tolerance && worst[1] <= 1e-9 && worst[2] <= 1e-8);
+        if ranks.rank() == 0 {
+            println!(
+                "strip load ({treatment:?}) on {} processes: iterations {:?}, |Δu|/|u| {:.1e}, |Δσ|/|σ| {:.1e}, |ΔR|/|R| {:.1e}",
+                ranks.size(),
+                iterations(&mine),
+                worst[0],
+                worst[1],
+                worst[2]
+            );
+        }
+    }
+}
+
+#[test]
+fn an_implicit_failure_on_one_process_stops_all_with_its_error() {
+    stop_reports(3, "child_strip_load_stray");
+}
+
+#[test]
+#[ignore = "run on each process by an_implicit_failure_on_one_process_stops_all_with_its_error"]
+fn child_strip_load_stray() {
+    if !is_child("child_strip_load_stray") {
+        return;
+    }
+    let mpi = Mpi::init();
+    let ranks = mpi.ranks();
+    let outcome = strip_load::on_ranks(
+        Box::new(ranks),
+        Treatment::Standard,
+        strip_load::Deal::Stray,
+    );
+    let Err(SolverError::InStep {
+        step: 0, source, ..
+    }) = outcome
+    else {
+        panic!("expected the first step to stop: {outcome:?}");
+    };
+    match (ranks.rank(), *source) {
+        (1, e @ SolverError::Basis { .. }) => println!("stopped: typed {e}"),
+        (0 | 2, e @ SolverError::Rank { rank: 1, .. }) => println!("stopped: {e}"),
+        (rank, e) => panic!("rank {rank}: {e:?}"),
+    }
 }

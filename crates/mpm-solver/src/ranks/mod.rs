@@ -18,6 +18,7 @@
 
 pub mod disks;
 pub mod halo;
+pub mod strip_load;
 mod threads;
 
 pub use threads::ThreadRanks;
