@@ -75,6 +75,13 @@ enum SolveCode {
     Misconfigured = 2,
 }
 
+impl SolveCode {
+    /// The code as the reduction carries it.
+    fn value(self) -> f64 {
+        f64::from(self as u8)
+    }
+}
+
 impl RankLink {
     /// A link through `ranks`.
     pub(super) fn new(ranks: Box<dyn Ranks>) -> Self {
@@ -118,44 +125,24 @@ impl RankLink {
     /// and every other rank [`StepFailure::OnRank`] with its message and
     /// whether it backtracks, so that all ranks take the same branch.
     pub(super) fn agree_step(&mut self, local: Result<(), StepFailure>) -> Result<(), StepFailure> {
-        let me = self.ranks.rank();
-        let mut failing = [if local.is_err() {
-            me as f64
-        } else {
-            f64::INFINITY
-        }];
-        if let Err(e) = self.ranks.all_reduce(&mut failing, Reduce::Min) {
-            return Err(StepFailure::OnRank {
-                rank: e.rank,
-                message: e.message,
-                backtrack: false,
-            });
-        }
-        if failing[0].is_infinite() {
-            return local;
-        }
-        let root = failing[0] as usize;
         // The first character says whether the failure backtracks.
-        let mut text = match &local {
-            Err(f) if me == root => format!("{}{f}", if backtracks(f) { 'b' } else { 'f' }),
-            _ => String::new(),
+        let describe = || match &local {
+            Err(f) => format!("{}{f}", if backtracks(f) { 'b' } else { 'f' }),
+            Ok(()) => String::new(),
         };
-        if let Err(e) = self.ranks.broadcast_text(root, &mut text) {
-            return Err(StepFailure::OnRank {
+        match ranks::lowest_failure(self.ranks.as_ref(), local.is_err(), describe) {
+            Err(e) => Err(StepFailure::OnRank {
                 rank: e.rank,
                 message: e.message,
                 backtrack: false,
-            });
+            }),
+            Ok(Some((rank, text))) if rank != self.ranks.rank() => Err(StepFailure::OnRank {
+                rank,
+                backtrack: text.starts_with('b'),
+                message: text.get(1..).unwrap_or_default().to_owned(),
+            }),
+            Ok(_) => local,
         }
-        if me == root {
-            return local;
-        }
-        let backtrack = text.starts_with('b');
-        Err(StepFailure::OnRank {
-            rank: root,
-            message: text.get(1..).unwrap_or_default().to_owned(),
-            backtrack,
-        })
     }
 
     /// Marks the nodes any rank's points touch: `marks` holds 0 for a
@@ -272,15 +259,16 @@ impl RankLink {
         }
         let root = self.ranks.rank() == 0;
         let mut local = Ok(());
-        let mut code = [SolveCode::Solved as u8 as f64];
+        let mut code = [SolveCode::Solved.value()];
         if root {
             local = linear.solve(values, rhs).map(|_| ());
             if let Err(e) = &local {
                 rhs.fill(0.0);
-                code[0] = f64::from(match e {
-                    LinearSolveError::Configuration { .. } => SolveCode::Misconfigured as u8,
-                    _ => SolveCode::Failed as u8,
-                });
+                code[0] = match e {
+                    LinearSolveError::Configuration { .. } => SolveCode::Misconfigured,
+                    _ => SolveCode::Failed,
+                }
+                .value();
             }
         } else {
             rhs.fill(0.0);
@@ -292,7 +280,7 @@ impl RankLink {
         self.ranks
             .all_reduce(&mut code, Reduce::Max)
             .map_err(transport)?;
-        if code[0] == SolveCode::Solved as u8 as f64 {
+        if code[0] == SolveCode::Solved.value() {
             // Zeros elsewhere: the sum is rank 0's solution exactly.
             return self.ranks.all_reduce(rhs, Reduce::Sum).map_err(transport);
         }
@@ -303,7 +291,7 @@ impl RankLink {
         self.ranks.broadcast_text(0, &mut text).map_err(transport)?;
         match local {
             Err(e) => Err(e),
-            Ok(()) if code[0] == SolveCode::Misconfigured as u8 as f64 => {
+            Ok(()) if code[0] == SolveCode::Misconfigured.value() => {
                 Err(LinearSolveError::Configuration {
                     library: "rank 0's linear solver",
                     message: text,

@@ -243,6 +243,33 @@ impl Decomposition {
     }
 }
 
+/// When any rank failed (`failed` on this one), the lowest failing rank
+/// and its message, which `describe` gives on that rank alone; `None`
+/// when no rank failed, after one reduction.
+///
+/// # Errors
+/// The transport's.
+pub fn lowest_failure(
+    ranks: &dyn Ranks,
+    failed: bool,
+    describe: impl FnOnce() -> String,
+) -> Result<Option<(usize, String)>, RankError> {
+    let me = ranks.rank();
+    let mut failing = [if failed { me as f64 } else { f64::INFINITY }];
+    ranks.all_reduce(&mut failing, Reduce::Min)?;
+    if failing[0].is_infinite() {
+        return Ok(None);
+    }
+    let root = failing[0] as usize;
+    let mut text = if me == root {
+        describe()
+    } else {
+        String::new()
+    };
+    ranks.broadcast_text(root, &mut text)?;
+    Ok(Some((root, text)))
+}
+
 /// Decides a local outcome collectively: when any rank failed, every rank
 /// returns an error — the lowest failing rank its own, the others
 /// [`SolverError::Rank`] carrying that error's message — so all ranks stop
@@ -252,28 +279,15 @@ impl Decomposition {
 /// # Errors
 /// As above, or the transport's.
 pub fn agree<T>(ranks: &dyn Ranks, local: Result<T, SolverError>) -> Result<T, SolverError> {
-    let me = ranks.rank();
-    let mut failing = [if local.is_err() {
-        me as f64
-    } else {
-        f64::INFINITY
-    }];
-    ranks.all_reduce(&mut failing, Reduce::Min)?;
-    if failing[0].is_infinite() {
-        return local;
-    }
-    let root = failing[0] as usize;
-    let mut text = match &local {
-        Err(e) if me == root => e.to_string(),
-        _ => String::new(),
-    };
-    ranks.broadcast_text(root, &mut text)?;
-    if me == root {
+    let describe = || {
         local
-    } else {
-        Err(SolverError::Rank {
-            rank: root,
-            message: text,
-        })
+            .as_ref()
+            .err()
+            .map(ToString::to_string)
+            .unwrap_or_default()
+    };
+    match lowest_failure(ranks, local.is_err(), describe)? {
+        Some((rank, message)) if rank != ranks.rank() => Err(SolverError::Rank { rank, message }),
+        _ => local,
     }
 }
