@@ -79,6 +79,7 @@ pub mod linear;
 pub mod locking;
 pub mod mesh;
 pub mod moving_mesh;
+pub mod par;
 pub mod parts;
 pub mod points;
 pub mod ranks;

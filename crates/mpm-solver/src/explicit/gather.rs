@@ -10,7 +10,6 @@
 use mpm_basis::BasisFunction;
 use mpm_constitutive::IncrementalLaw;
 use nalgebra::{SMatrix, SVector};
-use rayon::prelude::*;
 
 use super::{
     DilatationTreatment, ExplicitMesh, ExplicitSolver, GridState, PointMut, PointsOf,
@@ -19,6 +18,7 @@ use super::{
 use crate::domain::{DomainContext, DomainUpdater};
 use crate::error::PointFailure;
 use crate::mesh::NodalMesh;
+use crate::par::{self, Rows};
 
 /// What one pass of the grid-to-point loop does to each point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,88 +101,100 @@ where
         let (sums, starts) = (&self.cell_sums, &self.position_scratch);
         let alpha = self.transfer.alpha();
         let kept = (
-            chunks_or_empty(&mut self.grad_scratch, per, tasks),
-            chunks_or_empty(&mut self.cell_scratch, per, tasks),
+            rows_or_empty(&mut self.grad_scratch, per, tasks),
+            rows_or_empty(&mut self.cell_scratch, per, tasks),
         );
         let p = points;
-        let results: Vec<Result<f64, (usize, PointFailure)>> = (
+        let data = (
             (
-                p.position.par_chunks_mut(per),
-                p.velocity.par_chunks_mut(per),
-                p.f.par_chunks_mut(per),
-                p.volume.par_chunks_mut(per),
-                p.tau.par_chunks_mut(per),
-                p.material.par_chunks_mut(per),
+                Rows::new(&mut p.position, per),
+                Rows::new(&mut p.velocity, per),
+                Rows::new(&mut p.f, per),
+                Rows::new(&mut p.volume, per),
+                Rows::new(&mut p.tau, per),
+                Rows::new(&mut p.material, per),
             ),
             (
-                p.transfer.par_chunks_mut(per),
-                p.mass.par_chunks(per),
-                p.volume0.par_chunks(per),
-                p.domain.par_chunks_mut(per),
-                p.domain0.par_chunks(per),
+                Rows::new(&mut p.transfer, per),
+                Rows::new(&mut p.domain, per),
             ),
             kept,
-        )
-            .into_par_iter()
-            .enumerate()
-            .map(
-                |(
-                    task,
-                    ((x, v, f, vol, tau, mat), (tr, mass, vol0, dom, dom0), (grads, cells)),
-                )| {
-                    let mut stencil = basis.new_stencil();
-                    let deformer = Deformer::<D, B, L, R> {
-                        law,
-                        rule,
-                        field: DomainField::new(mesh, grid, fixities, dt),
+        );
+        let (mass, volume0, domain0) = (&p.mass[..], &p.volume0[..], &p.domain0[..]);
+        par::reduce(
+            data,
+            1,
+            &|first_task, (mut moving, mut state, mut kept)| {
+                let mut stencil = basis.new_stencil();
+                let deformer = Deformer::<D, B, L, R> {
+                    law,
+                    rule,
+                    field: DomainField::new(mesh, grid, fixities, dt),
+                };
+                let mut signal: Result<f64, (usize, PointFailure)> = Ok(0.0);
+                for t in 0..moving.0.len() {
+                    let (x, v, f) = (moving.0.row(t), moving.1.row(t), moving.2.row(t));
+                    let (vol, tau, mat) = (moving.3.row(t), moving.4.row(t), moving.5.row(t));
+                    let (tr, dom) = (state.0.row(t), state.1.row(t));
+                    let (grads, cells) = (kept.0.row(t), kept.1.row(t));
+                    let task = first_task + t;
+                    let mut task_signal = || -> Result<f64, (usize, PointFailure)> {
+                        let mut signal: f64 = 0.0;
+                        for k in 0..x.len() {
+                            let point = task * per + k;
+                            let (grad, start) = if pass == Pass::Deform {
+                                (grads[k], *starts.get(point).unwrap_or(&x[k]))
+                            } else {
+                                let g = g2p::interpolate(
+                                    basis,
+                                    mesh,
+                                    &x[k],
+                                    &dom[k],
+                                    grid,
+                                    &mut stencil,
+                                )
+                                .map_err(|e| (point, e))?;
+                                let start = x[k];
+                                if pass == Pass::Move {
+                                    cells[k] = mesh.cell_of(&x[k]).unwrap_or(usize::MAX);
+                                }
+                                g2p::move_point(alpha, dt, &g, &mut x[k], &mut v[k]);
+                                if pass == Pass::Move {
+                                    grads[k] = g.grad;
+                                    continue;
+                                }
+                                (g.grad, start)
+                            };
+                            let bar = (pass == Pass::Deform)
+                                .then(|| averaged_gradient(&grad, sums.get(cells[k])));
+                            let s = deformer
+                                .deform::<T>(
+                                    &grad,
+                                    bar.as_ref(),
+                                    PointMut {
+                                        f: &mut f[k],
+                                        volume: &mut vol[k],
+                                        volume0: volume0[point],
+                                        tau: &mut tau[k],
+                                        material: &mut mat[k],
+                                        transfer: &mut tr[k],
+                                        mass: mass[point],
+                                        velocity: &v[k],
+                                    },
+                                    (&start, &x[k]),
+                                    (&domain0[point], &mut dom[k]),
+                                )
+                                .map_err(|e| (point, e))?;
+                            signal = signal.max(s);
+                        }
+                        Ok(signal)
                     };
-                    let mut signal: f64 = 0.0;
-                    for k in 0..x.len() {
-                        let point = task * per + k;
-                        let (grad, start) = if pass == Pass::Deform {
-                            (grads[k], *starts.get(point).unwrap_or(&x[k]))
-                        } else {
-                            let g =
-                                g2p::interpolate(basis, mesh, &x[k], &dom[k], grid, &mut stencil)
-                                    .map_err(|e| (point, e))?;
-                            let start = x[k];
-                            if pass == Pass::Move {
-                                cells[k] = mesh.cell_of(&x[k]).unwrap_or(usize::MAX);
-                            }
-                            g2p::move_point(alpha, dt, &g, &mut x[k], &mut v[k]);
-                            if pass == Pass::Move {
-                                grads[k] = g.grad;
-                                continue;
-                            }
-                            (g.grad, start)
-                        };
-                        let bar = (pass == Pass::Deform)
-                            .then(|| averaged_gradient(&grad, sums.get(cells[k])));
-                        let s = deformer
-                            .deform::<T>(
-                                &grad,
-                                bar.as_ref(),
-                                PointMut {
-                                    f: &mut f[k],
-                                    volume: &mut vol[k],
-                                    volume0: vol0[k],
-                                    tau: &mut tau[k],
-                                    material: &mut mat[k],
-                                    transfer: &mut tr[k],
-                                    mass: mass[k],
-                                    velocity: &v[k],
-                                },
-                                (&start, &x[k]),
-                                (&dom0[k], &mut dom[k]),
-                            )
-                            .map_err(|e| (point, e))?;
-                        signal = signal.max(s);
-                    }
-                    Ok(signal)
-                },
-            )
-            .collect();
-        first_error(results.into_iter())
+                    signal = worse(signal, task_signal());
+                }
+                signal
+            },
+            worse,
+        )
     }
 }
 
@@ -204,13 +216,13 @@ fn averaged_gradient<const D: usize>(
     bar
 }
 
-/// `v` in chunks of `per`, or `tasks` empty chunks when nothing is kept
-/// (the fused pass keeps no gradients).
-fn chunks_or_empty<X>(v: &mut [X], per: usize, tasks: usize) -> Vec<&mut [X]> {
+/// `v` in rows of `per`, or `tasks` empty rows when nothing is kept (the
+/// fused pass keeps no gradients).
+fn rows_or_empty<X>(v: &mut [X], per: usize, tasks: usize) -> Rows<'_, X> {
     if v.is_empty() {
-        (0..tasks).map(|_| Default::default()).collect()
+        Rows::empty(tasks)
     } else {
-        v.chunks_mut(per).collect()
+        Rows::new(v, per)
     }
 }
 
@@ -351,17 +363,15 @@ fn task_size(n: usize) -> usize {
         .max(64)
 }
 
-/// The largest value, or the error of the lowest-numbered point.
-pub(super) fn first_error(
-    results: impl Iterator<Item = Result<f64, (usize, PointFailure)>>,
+/// Of two partial results, the failure of the lower-numbered point, or
+/// the larger value.
+pub(super) fn worse(
+    a: Result<f64, (usize, PointFailure)>,
+    b: Result<f64, (usize, PointFailure)>,
 ) -> Result<f64, (usize, PointFailure)> {
-    let mut best: Result<f64, (usize, PointFailure)> = Ok(0.0);
-    for r in results {
-        best = match (best, r) {
-            (Ok(a), Ok(b)) => Ok(a.max(b)),
-            (Err(a), Err(b)) => Err(if b.0 < a.0 { b } else { a }),
-            (Err(a), Ok(_)) | (Ok(_), Err(a)) => Err(a),
-        };
+    match (a, b) {
+        (Ok(a), Ok(b)) => Ok(a.max(b)),
+        (Err(a), Err(b)) => Err(if b.0 < a.0 { b } else { a }),
+        (Err(a), Ok(_)) | (Ok(_), Err(a)) => Err(a),
     }
-    best
 }

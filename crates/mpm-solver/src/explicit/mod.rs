@@ -48,7 +48,6 @@ pub mod verification;
 use mpm_basis::BasisFunction;
 use mpm_constitutive::IncrementalLaw;
 use nalgebra::{SMatrix, SVector};
-use rayon::prelude::*;
 
 pub use dilatation::{CellAveraged, DilatationTreatment};
 pub use energy::Energies;
@@ -64,8 +63,8 @@ use crate::domain::{DomainUpdater, NoUpdate};
 use crate::error::{PointFailure, SolverError};
 use crate::locking::NoLocking;
 use crate::mesh::NodalMesh;
+use crate::par;
 use crate::ranks::{self, Reduce};
-use gather::first_error;
 use on_ranks::OnRanks;
 
 /// Points of one grid-to-point task per thread, times this.
@@ -694,27 +693,32 @@ where
             &self.options.gravity,
             &self.node_position,
         );
-        let results: Vec<Result<(), (usize, PointFailure)>> = self
-            .buffers
-            .par_iter_mut()
-            .enumerate()
-            .map(|(k, buffer)| {
-                buffer.clear();
-                let range = (k * per).min(n)..((k + 1) * per).min(n);
+        par::reduce(
+            &mut self.buffers[..],
+            1,
+            &|first, buffers| {
                 let mut stencil = basis.new_stencil();
-                p2g::scatter::<D, B, T>(
-                    basis,
-                    mesh,
-                    &view,
-                    node_position,
-                    gravity,
-                    range,
-                    buffer,
-                    &mut stencil,
-                )
-            })
-            .collect();
-        first_error(results.into_iter().map(|r| r.map(|()| 0.0)))?;
+                let mut result = Ok(0.0);
+                for (j, buffer) in buffers.iter_mut().enumerate() {
+                    let k = first + j;
+                    buffer.clear();
+                    let range = (k * per).min(n)..((k + 1) * per).min(n);
+                    let scattered = p2g::scatter::<D, B, T>(
+                        basis,
+                        mesh,
+                        &view,
+                        node_position,
+                        gravity,
+                        range,
+                        buffer,
+                        &mut stencil,
+                    );
+                    result = gather::worse(result, scattered.map(|()| 0.0));
+                }
+                result
+            },
+            gather::worse,
+        )?;
         if !points.point_force.is_empty() {
             let mut stencil = self.basis.new_stencil();
             p2g::scatter_point_forces(

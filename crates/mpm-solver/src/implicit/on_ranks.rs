@@ -31,7 +31,7 @@ use crate::error::{SolverError, StepFailure};
 use crate::linear::{LinearSolveError, LinearSolver};
 use crate::locking::PatchAssignment;
 use crate::ranks::{self, RankError, Ranks, Reduce};
-use crate::stages::system::NONE;
+use crate::stages::system::{Candidates, NONE};
 
 /// The implicit solver's link to the other ranks of a distributed run.
 pub(super) struct RankLink {
@@ -167,7 +167,7 @@ impl RankLink {
         &mut self,
         nb_ptr: &[usize],
         nb: &[u32],
-        rebuild: impl FnOnce(&dyn Fn(usize, &mut dyn FnMut(u32))),
+        rebuild: &mut dyn FnMut(&Candidates<'_>),
     ) {
         let (me, size) = self.rank_and_size();
         let others: Vec<usize> = (0..size).filter(|&q| q != me).collect();

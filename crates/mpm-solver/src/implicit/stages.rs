@@ -7,8 +7,6 @@ use mpm_constitutive::{
     ConsistentTangent, ConstitutiveError, LogStrainLaw, MaterialState, Response, update,
 };
 use nalgebra::{Matrix3, SVector};
-use rayon::iter::Either;
-use rayon::prelude::*;
 
 use super::on_ranks::{self, RankLink};
 use super::{ImplicitSolver, MAX_BACKTRACKS};
@@ -19,6 +17,7 @@ use crate::linear::LinearSolveError;
 use crate::locking::{LockingTreatment, PatchInput};
 use crate::mesh::MovableMesh;
 use crate::mesh::NodalMesh;
+use crate::par::{self, Rows};
 use crate::parts::{PointsOf, SolverParts};
 use crate::stages::gather::PointStress;
 use crate::stages::patch::PatchSystem;
@@ -40,6 +39,11 @@ fn failed_point(f: &StepFailure) -> Option<usize> {
         }
         _ => None,
     }
+}
+
+/// The failure of point `point`'s constitutive update or tangent.
+fn at_point(point: usize, source: ConstitutiveError) -> StepFailure {
+    StepFailure::Constitutive { point, source }
 }
 
 /// Of two parallel partial results, the failure of the lowest point,
@@ -96,12 +100,7 @@ impl<const D: usize, P: SolverParts<D>> PointPass<'_, D, P> {
         let response = update(self.law, &delta_f, &self.points.f[p], &state);
         let r = match response.as_ref() {
             Ok(r) => r,
-            Err(source) => {
-                return Some(StepFailure::Constitutive {
-                    point: p,
-                    source: *source,
-                });
-            }
+            Err(source) => return Some(at_point(p, *source)),
         };
         // Squared norms: the square root only for the report.
         let squared = r.delta_f.norm_squared().max(r.delta_f_inv.norm_squared());
@@ -214,7 +213,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let sys = &mut self.system;
         let constraints = &self.constraints;
         let active_of_mesh = std::mem::take(&mut sys.active_of_mesh);
-        sys.build_pattern(|node, i| {
+        sys.build_pattern(&|node, i| {
             let held = weak[active_of_mesh[node] as usize];
             constraints
                 .prescribed(node, i, lambda0, lambda1)
@@ -263,7 +262,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let node_count = self.mesh.node_count();
         let sys = &mut self.system;
         match &mut self.ranks {
-            Some(link) => sys.number_nodes_with(node_count, |marks| link.unite_nodes(marks)),
+            Some(link) => sys.number_nodes_with(node_count, &mut |marks| link.unite_nodes(marks)),
             None => sys.number_nodes(node_count),
         }
         sys.build_adjacency();
@@ -305,7 +304,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             &points.position,
             &points.volume,
             &self.system,
-            |p| g.factor * 2.0 * law.point_shear_modulus(&history[p]).unwrap_or(0.0),
+            &|p| g.factor * 2.0 * law.point_shear_modulus(&history[p]).unwrap_or(0.0),
             g.fill,
         )?;
         Ok(())
@@ -332,18 +331,18 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             self.patches.build(&self.system);
             let patches = &self.patches;
             self.system
-                .build_neighbours_from(|w, push| patches.neighbours(w, push));
+                .build_neighbours_from(&|w, push| patches.neighbours(w, push));
         } else {
             self.system.build_neighbours();
         }
         let sys = &mut self.system;
         if let Some(link) = &mut self.ranks {
             let (nb_ptr, nb) = (std::mem::take(&mut sys.nb_ptr), std::mem::take(&mut sys.nb));
-            link.unite_neighbours(&nb_ptr, &nb, |all| sys.build_neighbours_from(all));
+            link.unite_neighbours(&nb_ptr, &nb, &mut |all| sys.build_neighbours_from(all));
         }
         let ghost = &self.ghost;
         if !ghost.is_empty() {
-            sys.extend_neighbours(|w, push| ghost.partners(w, push));
+            sys.extend_neighbours(&|w, push| ghost.partners(w, push));
         }
         if self.locking.couples_points() {
             self.patches.build_placement(sys);
@@ -503,10 +502,11 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let coupled = self.locking.couples_points();
         if coupled {
             it.increments.resize(n, Matrix3::identity());
-            it.increments
-                .par_iter_mut()
-                .enumerate()
-                .for_each(|(p, m)| *m = grid_to_point::deformation_increment(sys, du, p));
+            par::for_each(&mut it.increments[..], 1, &|start, increments| {
+                for (k, m) in increments.iter_mut().enumerate() {
+                    *m = grid_to_point::deformation_increment(sys, du, start + k);
+                }
+            });
             self.patches
                 .average(&it.increments)
                 .map_err(|e| StepFailure::Constitutive {
@@ -520,16 +520,12 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let (law, patches, increments) = (&self.law, &self.patches, &it.increments[..]);
         let limit = self.options.max_increment_norm;
         let stride = sys.stride.max(1);
-        // Each point's slots of the mapped gradients, or an empty slice
-        // per point when the formulation does not map them.
+        // Each point's slots of the mapped gradients, or an empty row per
+        // point when the formulation does not map them.
         let mapped = if maps_gradients {
-            Either::Left(it.mapped.par_chunks_mut(stride))
+            Rows::new(&mut it.mapped, stride)
         } else {
-            Either::Right(
-                (0..n)
-                    .into_par_iter()
-                    .map(|_| <&mut [SVector<f64, D>]>::default()),
-            )
+            Rows::empty(n)
         };
         let pass = PointPass::<D, P> {
             sys,
@@ -542,49 +538,60 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             coupled,
         };
         let failure = if TANGENTS {
-            it.stress_w
-                .par_iter_mut()
-                .zip(mapped)
-                .zip(it.tangent_w.par_iter_mut())
-                .zip(it.tangent_norms.par_iter_mut())
-                .enumerate()
-                .map(|(p, (((stress, chunk), t), norm))| {
-                    pass.respond(p, |r| {
-                        pass.weigh(p, r, stress, chunk);
-                        let volume = P::Formulation::volume(r, points.volume[p]);
-                        // Read in place, as the response.
-                        let tangent = <P::Formulation as Formulation>::Tangent::tangent(law, r);
-                        let a = match tangent.as_ref() {
-                            Ok(a) => a,
-                            Err(source) => {
-                                return Some(StepFailure::Constitutive {
-                                    point: p,
-                                    source: *source,
-                                });
+            let data = (
+                &mut it.stress_w[..],
+                mapped,
+                &mut it.tangent_w[..],
+                &mut it.tangent_norms[..],
+            );
+            par::reduce(
+                data,
+                1,
+                &|start, (stress, mut mapped, t, norm)| {
+                    let mut failure = None;
+                    for k in 0..stress.len() {
+                        let p = start + k;
+                        let f = pass.respond(p, |r| {
+                            pass.weigh(p, r, &mut stress[k], mapped.row(k));
+                            let volume = P::Formulation::volume(r, points.volume[p]);
+                            // Read in place, as the response.
+                            let tangent = <P::Formulation as Formulation>::Tangent::tangent(law, r);
+                            let a = match tangent.as_ref() {
+                                Ok(a) => a,
+                                Err(source) => return Some(at_point(p, *source)),
+                            };
+                            gather::restrict_tangent(a, volume, &mut t[k]);
+                            if norms {
+                                norm[k] = (a * volume).norm();
                             }
-                        };
-                        gather::restrict_tangent(a, volume, t);
-                        if norms {
-                            *norm = (a * volume).norm();
-                        }
-                        None
-                    })
-                })
-                .reduce(|| None, lowest_failure)
+                            None
+                        });
+                        failure = lowest_failure(failure, f);
+                    }
+                    failure
+                },
+                lowest_failure,
+            )
         } else {
-            it.stress_w
-                .par_iter_mut()
-                .zip(mapped)
-                .zip(it.responses.par_iter_mut())
-                .enumerate()
-                .map(|(p, ((stress, chunk), response))| {
-                    pass.respond(p, |r| {
-                        pass.weigh(p, r, stress, chunk);
-                        *response = Some(*r);
-                        None
-                    })
-                })
-                .reduce(|| None, lowest_failure)
+            let data = (&mut it.stress_w[..], mapped, &mut it.responses[..]);
+            par::reduce(
+                data,
+                1,
+                &|start, (stress, mut mapped, responses)| {
+                    let mut failure = None;
+                    for k in 0..stress.len() {
+                        let p = start + k;
+                        let f = pass.respond(p, |r| {
+                            pass.weigh(p, r, &mut stress[k], mapped.row(k));
+                            responses[k] = Some(*r);
+                            None
+                        });
+                        failure = lowest_failure(failure, f);
+                    }
+                    failure
+                },
+                lowest_failure,
+            )
         };
         match failure {
             Some(f) => Err(f),
@@ -669,40 +676,44 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let responses = &it.responses;
         it.tangent_w.resize(n, [[[[0.0; D]; D]; D]; D]);
         it.tangent_norms.resize(n, 0.0);
-        it.tangent_w
-            .par_iter_mut()
-            .zip(it.tangent_norms.par_iter_mut())
-            .enumerate()
-            .try_for_each(|(p, (t, norm))| {
-                let Some(r) = &responses[p] else {
-                    return Ok::<(), StepFailure>(());
-                };
-                let volume = P::Formulation::volume(r, points.volume[p]);
-                // Read in place: moving the tensor out of its `Result` is a
-                // 648-byte copy the compiler does not elide.
-                let tangent = if loading {
-                    <P::Formulation as Formulation>::Tangent::loading_tangent(law, r)
-                } else {
-                    <P::Formulation as Formulation>::Tangent::tangent(law, r)
-                };
-                let a = tangent
-                    .as_ref()
-                    .map_err(|source| StepFailure::Constitutive {
-                        point: p,
-                        source: *source,
-                    })?;
-                gather::restrict_tangent(a, volume, t);
-                if norms {
-                    // Of the tensor the stiffness uses: scaled by α_p under
-                    // a coupled treatment (`patch_tangents`).
-                    *norm = if coupled {
-                        (a * volume * alpha[p]).norm()
-                    } else {
-                        (a * volume).norm()
+        let failure = par::first(
+            (&mut it.tangent_w[..], &mut it.tangent_norms[..]),
+            1,
+            &|start, (t, norm)| {
+                for k in 0..t.len() {
+                    let p = start + k;
+                    let Some(r) = &responses[p] else {
+                        continue;
                     };
+                    let volume = P::Formulation::volume(r, points.volume[p]);
+                    // Read in place: moving the tensor out of its `Result`
+                    // is a 648-byte copy the compiler does not elide.
+                    let tangent = if loading {
+                        <P::Formulation as Formulation>::Tangent::loading_tangent(law, r)
+                    } else {
+                        <P::Formulation as Formulation>::Tangent::tangent(law, r)
+                    };
+                    let a = match tangent.as_ref() {
+                        Ok(a) => a,
+                        Err(source) => return Some(at_point(p, *source)),
+                    };
+                    gather::restrict_tangent(a, volume, &mut t[k]);
+                    if norms {
+                        // Of the tensor the stiffness uses: scaled by α_p
+                        // under a coupled treatment (`patch_tangents`).
+                        norm[k] = if coupled {
+                            (a * volume * alpha[p]).norm()
+                        } else {
+                            (a * volume).norm()
+                        };
+                    }
                 }
-                Ok(())
-            })?;
+                None
+            },
+        );
+        if let Some(f) = failure {
+            return Err(f);
+        }
         if coupled {
             self.patch_tangents();
         }
@@ -758,7 +769,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let it = &mut self.it;
         let responses = &it.responses;
         let patches = &mut self.patches;
-        patches.gradients(&self.system, |p| {
+        patches.gradients(&self.system, &|p| {
             responses[p]
                 .as_ref()
                 .map_or_else(Matrix3::identity, |r| r.delta_f_inv)
@@ -771,28 +782,27 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         };
         let stride = sys.stride.max(1);
         let alpha = &patches.alpha;
-        patches
-            .h
-            .par_chunks_mut(stride)
-            .zip(it.tangent_w.par_iter_mut())
-            .enumerate()
-            .for_each(|(p, (h, t))| {
+        let data = (Rows::new(&mut patches.h, stride), &mut it.tangent_w[..]);
+        par::for_each(data, 1, &|start, (mut h, t)| {
+            for (k, t) in t.iter_mut().enumerate() {
+                let p = start + k;
                 let Some(r) = &responses[p] else {
-                    return;
+                    continue;
                 };
-                let k = P::Formulation::volumetric_direction(r);
+                let k_dir = P::Formulation::volumetric_direction(r);
                 let mut b = [[0.0f64; D]; D];
                 for (i, row) in b.iter_mut().enumerate() {
                     for (j, bij) in row.iter_mut().enumerate() {
                         let mut acc = 0.0;
                         for a in 0..D {
                             for c in 0..D {
-                                acc += t[i][j][a][c] * k[(a, c)];
+                                acc += t[i][j][a][c] * k_dir[(a, c)];
                             }
                         }
                         *bij = acc / D as f64;
                     }
                 }
+                let h = h.row(k);
                 for (slot, hv) in h.iter_mut().take(sys.counts[p] as usize).enumerate() {
                     let g = &grads[p * stride + slot];
                     *hv = SVector::<f64, D>::from_fn(|i, _| (0..D).map(|j| b[i][j] * g[j]).sum());
@@ -802,7 +812,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                     .flatten()
                     .flatten()
                     .for_each(|x| *x *= alpha[p]);
-            });
+            }
+        });
     }
 
     /// Stage 4d: the stiffness (eqs. 4/21, 27) in CSC over free dofs

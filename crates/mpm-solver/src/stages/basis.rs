@@ -5,10 +5,10 @@
 
 use mpm_basis::{BasisFunction, Stencil};
 use nalgebra::SVector;
-use rayon::prelude::*;
 
 use crate::error::SolverError;
 use crate::mesh::NodalMesh;
+use crate::par::{self, Rows};
 use crate::stages::system::StepSystem;
 
 /// Evaluates `basis` on `mesh` at every point (`position`, `domain`) into
@@ -17,10 +17,11 @@ use crate::stages::system::StepSystem;
 /// starts (the parent cell of the last step; walking on unstructured
 /// meshes, Wang et al. 2021 Algorithm 1), `usize::MAX` when unknown; it is
 /// resized to the number of points and updated. No allocation per point:
-/// each worker reuses one stencil buffer.
+/// each part of the parallel loop ([`crate::par`]) reuses one stencil
+/// buffer.
 ///
 /// # Errors
-/// [`SolverError::Basis`] naming the first failing point (one outside the
+/// [`SolverError::Basis`] naming the lowest failing point (one outside the
 /// mesh, a domain leaving the grid, a basis returning too many nodes).
 pub fn evaluate<const D: usize, B>(
     basis: &B,
@@ -47,39 +48,50 @@ where
     sys.counts.resize(n, 0);
     let node_count = mesh.node_count();
     hints.resize(n, usize::MAX);
-    sys.nodes
-        .par_chunks_mut(stride)
-        .zip(sys.values.par_chunks_mut(stride))
-        .zip(sys.grads.par_chunks_mut(stride))
-        .zip(sys.counts.par_iter_mut())
-        .zip(hints.par_iter_mut())
-        .enumerate()
-        .try_for_each_init(
-            || Stencil::<D>::with_capacity(stride),
-            |stencil, (p, ((((nodes, values), grads), count), hint))| {
-                let x = &position[p];
-                let fail = |reason| SolverError::Basis {
-                    point: p,
-                    position: x.iter().copied().collect(),
-                    reason,
-                };
-                basis
-                    .evaluate_hinted(mesh, x, &domain[p], hint, stencil)
-                    .map_err(|e| fail(crate::error::BasisFailure::Basis(e)))?;
-                let m = stencil.nodes.len();
-                if m > stride || stencil.nodes.iter().any(|&v| v >= node_count) {
-                    return Err(fail(crate::error::BasisFailure::Stencil {
-                        nodes: m,
-                        max: stride,
-                    }));
-                }
-                for a in 0..m {
-                    nodes[a] = stencil.nodes[a] as u32;
-                    values[a] = stencil.values[a];
-                    grads[a] = stencil.gradients[a];
-                }
-                *count = m as u32;
-                Ok(())
-            },
-        )
+    let data = (
+        Rows::new(&mut sys.nodes, stride),
+        Rows::new(&mut sys.values, stride),
+        Rows::new(&mut sys.grads, stride),
+        &mut sys.counts[..],
+        &mut hints[..],
+    );
+    let failure = par::first(data, 1, &|start,
+                                        (
+        mut nodes,
+        mut values,
+        mut grads,
+        counts,
+        hints,
+    )| {
+        let mut stencil = Stencil::<D>::with_capacity(stride);
+        for k in 0..counts.len() {
+            let p = start + k;
+            let x = &position[p];
+            let fail = |reason| SolverError::Basis {
+                point: p,
+                position: x.iter().copied().collect(),
+                reason,
+            };
+            if let Err(e) = basis.evaluate_hinted(mesh, x, &domain[p], &mut hints[k], &mut stencil)
+            {
+                return Some(fail(crate::error::BasisFailure::Basis(e)));
+            }
+            let m = stencil.nodes.len();
+            if m > stride || stencil.nodes.iter().any(|&v| v >= node_count) {
+                return Some(fail(crate::error::BasisFailure::Stencil {
+                    nodes: m,
+                    max: stride,
+                }));
+            }
+            let (nodes, values, grads) = (nodes.row(k), values.row(k), grads.row(k));
+            for a in 0..m {
+                nodes[a] = stencil.nodes[a] as u32;
+                values[a] = stencil.values[a];
+                grads[a] = stencil.gradients[a];
+            }
+            counts[k] = m as u32;
+        }
+        None
+    });
+    failure.map_or(Ok(()), Err)
 }

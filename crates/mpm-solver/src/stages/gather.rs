@@ -478,7 +478,7 @@ mod tests {
         }
         sys.build_neighbours();
         // Mesh node 5 fully free, 7 with its y prescribed, 9 fixed.
-        sys.build_pattern(|node, i| match (node, i) {
+        sys.build_pattern(&|node, i| match (node, i) {
             (7, 1) | (9, _) => Some(0.0),
             _ => None,
         });
@@ -510,7 +510,7 @@ mod tests {
         sys.build_neighbours();
         // Mesh node 0 fixed, every other node free: a flagged entry can
         // only be a fall-back.
-        sys.build_pattern(|node, _| (node == 0).then_some(0.0));
+        sys.build_pattern(&|node, _| (node == 0).then_some(0.0));
         let k = table_equals_search(&mut sys);
         assert!(k.iter().all(|v| v.is_finite()));
         // Both kinds of free pairs occur: direct offsets and the flagged

@@ -158,7 +158,7 @@ impl GhostFaces {
         position: &[SVector<f64, D>],
         volume: &[f64],
         sys: &StepSystem<D>,
-        modulus: impl Fn(usize) -> f64,
+        modulus: &dyn Fn(usize) -> f64,
         fill: f64,
     ) -> Result<(), MeshError> {
         self.clear();
@@ -400,7 +400,7 @@ mod tests {
         let sys = all_active(grid);
         let mut faces = GhostFaces::default();
         faces
-            .build(grid, &x, &v, &sys, |_| 3.0, 0.9)
+            .build(grid, &x, &v, &sys, &|_| 3.0, 0.9)
             .unwrap_or_else(|e| panic!("{e}"));
         faces
     }
@@ -417,11 +417,11 @@ mod tests {
         let sys = all_active(&grid);
         let soft = |p: usize| if x[p][0] < 1.75 { 1.0 } else { 5.0 };
         let mut unit = GhostFaces::default();
-        unit.build(&grid, &x, &v, &sys, |_| 1.0, 0.9)
+        unit.build(&grid, &x, &v, &sys, &|_| 1.0, 0.9)
             .unwrap_or_else(|e| panic!("{e}"));
         let mut mixed = GhostFaces::default();
         mixed
-            .build(&grid, &x, &v, &sys, soft, 0.9)
+            .build(&grid, &x, &v, &sys, &soft, 0.9)
             .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(unit.nodes, mixed.nodes);
         let mut cell_max = vec![0.0f64; grid.cell_count()];

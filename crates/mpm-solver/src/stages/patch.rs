@@ -300,7 +300,7 @@ impl<const D: usize> PatchSystem<D> {
     pub fn gradients(
         &mut self,
         sys: &StepSystem<D>,
-        inverse: impl Fn(usize) -> Matrix3<f64> + Sync,
+        inverse: &(dyn Fn(usize) -> Matrix3<f64> + Sync),
     ) {
         let stride = sys.stride.max(1);
         let alpha = &self.alpha;

@@ -107,13 +107,13 @@ impl<const D: usize> StepSystem<D> {
     /// Marks the active nodes, numbers them by ascending mesh id and
     /// rewrites the stencils in active numbering.
     pub fn number_nodes(&mut self, node_count: usize) {
-        self.number_nodes_with(node_count, |_| {});
+        self.number_nodes_with(node_count, &mut |_| {});
     }
 
     /// [`Self::number_nodes`], with `unite` seeing the marks (0 for a
     /// node the points touch, [`NONE`] otherwise) before the numbering:
     /// on several ranks, it adds the nodes the other ranks' points touch.
-    pub fn number_nodes_with(&mut self, node_count: usize, unite: impl FnOnce(&mut [u32])) {
+    pub fn number_nodes_with(&mut self, node_count: usize, unite: &mut dyn FnMut(&mut [u32])) {
         self.active_of_mesh.clear();
         self.active_of_mesh.resize(node_count, NONE);
         for p in 0..self.counts.len() {
@@ -172,7 +172,7 @@ impl<const D: usize> StepSystem<D> {
             self.active.len(),
             &mut self.nb_ptr,
             &mut self.nb,
-            |w, push| {
+            &|w, push| {
                 for &(p, _) in &adj[adj_ptr[w]..adj_ptr[w + 1]] {
                     let start = p as usize * stride;
                     for &v in &nodes[start..start + counts[p as usize] as usize] {
@@ -188,7 +188,7 @@ impl<const D: usize> StepSystem<D> {
     /// which a coupled locking treatment gives its wider pattern
     /// ([`crate::stages::patch::PatchSystem::neighbours`]: nodes sharing
     /// a patch), as [`Self::extend_neighbours`] is the ghost penalty's.
-    pub fn build_neighbours_from(&mut self, neighbours: impl Fn(usize, &mut dyn FnMut(u32))) {
+    pub fn build_neighbours_from(&mut self, neighbours: &Candidates<'_>) {
         neighbour_lists(
             self.active.len(),
             &mut self.nb_ptr,
@@ -202,7 +202,7 @@ impl<const D: usize> StepSystem<D> {
     /// [`crate::stages::ghost::GhostFaces::partners`]); lists stay sorted
     /// and duplicate-free. Call it before anything records positions in
     /// the lists (the patch placement, [`Self::build_pattern`]).
-    pub fn extend_neighbours(&mut self, extra: impl Fn(usize, &mut dyn FnMut(u32))) {
+    pub fn extend_neighbours(&mut self, extra: &Candidates<'_>) {
         let (old_ptr, old) = (
             std::mem::take(&mut self.nb_ptr),
             std::mem::take(&mut self.nb),
@@ -211,7 +211,7 @@ impl<const D: usize> StepSystem<D> {
             self.active.len(),
             &mut self.nb_ptr,
             &mut self.nb,
-            |w, push| {
+            &|w, push| {
                 for &v in &old[old_ptr[w]..old_ptr[w + 1]] {
                     push(v);
                 }
@@ -292,7 +292,7 @@ impl<const D: usize> StepSystem<D> {
     /// Numbers the free dofs (ascending in `D * v + i`), records prescribed
     /// increments from `prescribed(mesh_node, component)`, and builds the
     /// CSC pattern over free dofs together with the block map.
-    pub fn build_pattern(&mut self, prescribed: impl Fn(usize, usize) -> Option<f64>) {
+    pub fn build_pattern(&mut self, prescribed: &dyn Fn(usize, usize) -> Option<f64>) {
         let n = self.n_active();
         self.free_of_dof.clear();
         self.prescribed.clear();
@@ -344,6 +344,9 @@ impl<const D: usize> StepSystem<D> {
     }
 }
 
+/// The candidate neighbours of node `w`, pushed one by one: `f(w, push)`.
+pub type Candidates<'a> = dyn Fn(usize, &mut dyn FnMut(u32)) + 'a;
+
 /// Sorted, duplicate-free neighbour lists of `n` nodes into the CSR
 /// `nb_ptr`/`nb`: node `w`'s list holds every node `candidates(w, push)`
 /// pushes.
@@ -351,7 +354,7 @@ fn neighbour_lists(
     n: usize,
     nb_ptr: &mut Vec<usize>,
     nb: &mut Vec<u32>,
-    candidates: impl Fn(usize, &mut dyn FnMut(u32)),
+    candidates: &Candidates<'_>,
 ) {
     let mut mark = vec![NONE; n];
     let mut row: Vec<u32> = Vec::with_capacity(64);
