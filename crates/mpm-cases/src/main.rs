@@ -15,7 +15,9 @@ use mpm_cases::CasesError;
 use mpm_cases::cases;
 use mpm_cases::session::Session;
 use mpm_cases::variant::BasisKind;
+use mpm_dispatch::on_ranks::SharedRanks;
 use mpm_solver::SolverError;
+use mpm_solver::ranks::Ranks as _;
 
 #[derive(Parser)]
 #[command(
@@ -80,13 +82,33 @@ enum Command {
 }
 
 fn main() {
-    if let Err(e) = run_cli(Cli::parse()) {
-        eprintln!("error: {e:#}");
+    // MPI lives until the end of `main` (finalised when dropped).
+    #[cfg(feature = "mpi")]
+    let mpi = mpm_cases::distributed::mpi_ranks::Mpi::init();
+    #[cfg(feature = "mpi")]
+    let ranks = processes(&mpi);
+    #[cfg(not(feature = "mpi"))]
+    let ranks = None;
+    if let Err(e) = run_cli(Cli::parse(), ranks.clone()) {
+        match ranks {
+            Some(r) => eprintln!("error (rank {} of {}): {e:#}", r.0.rank(), r.0.size()),
+            None => eprintln!("error: {e:#}"),
+        }
+        // Without finalising: a rank that failed alone must not wait for
+        // the others; mpirun ends the job.
         std::process::exit(1);
     }
 }
 
-fn run_cli(cli: Cli) -> Result<()> {
+/// The MPI processes this program was started on by `mpirun`, when more
+/// than one.
+#[cfg(feature = "mpi")]
+fn processes(mpi: &mpm_cases::distributed::mpi_ranks::Mpi) -> Option<SharedRanks> {
+    let ranks = mpi.ranks();
+    (ranks.size() > 1).then(|| SharedRanks(std::sync::Arc::new(ranks)))
+}
+
+fn run_cli(cli: Cli, ranks: Option<SharedRanks>) -> Result<()> {
     match cli.command {
         Command::List => {
             use std::fmt::Write as _;
@@ -164,7 +186,13 @@ fn run_cli(cli: Cli) -> Result<()> {
                     anyhow!("no case: give --case NAME or a scene file with `case = \"...\"`")
                 })?
             };
+            if ranks.is_some() && !is_scene {
+                return Err(anyhow!(
+                    "the built-in cases run on one process; run a scene file on several (`mpm scene --case {name} > {name}.toml`)"
+                ));
+            }
             let session = Session {
+                ranks,
                 case: name.clone(),
                 out,
                 resume,

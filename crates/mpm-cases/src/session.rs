@@ -36,6 +36,9 @@ pub struct Session {
     pub export_tangent: bool,
     /// Directory of the scene file: relative mesh paths start there.
     pub scene_dir: PathBuf,
+    /// The ranks of a run on several processes (`mpirun -n N mpm run`, a
+    /// program built with the `mpi` feature); `None` for one process.
+    pub ranks: Option<mpm_dispatch::on_ranks::SharedRanks>,
 }
 
 impl Session {
@@ -92,6 +95,7 @@ impl Session {
             resume,
             external_linear: mpm_distributed::external_linear(),
             export_tangent: self.export_tangent,
+            ranks: None,
         };
         let mut observer = Observer::new(writer, self.case.clone(), parameters);
         observer.stop_after = self.stop_after;

@@ -748,6 +748,7 @@ fn run(text: &str, set: &[String], dir: &Path, out: &Path) -> Result<(), CasesEr
         stop_after: Some(1),
         export_tangent: false,
         scene_dir: dir.to_path_buf(),
+        ranks: None,
     };
     scene::run_file(text, ORIGIN, set, &session)
 }

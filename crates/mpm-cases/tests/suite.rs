@@ -20,6 +20,7 @@ mod output_files;
 mod output_vtk;
 mod regression;
 mod scene_file;
+mod scene_ranks;
 mod scenes;
 mod shear;
 mod stretch;

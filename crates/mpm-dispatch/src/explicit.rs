@@ -221,6 +221,12 @@ fn dispatch<const D: usize>(
     observer: &mut ExplicitObserver<'_>,
 ) -> Result<ExplicitOutput, SolverError> {
     parts(problem)?;
+    if control.ranks.is_some() {
+        return Err(SolverError::InvalidInput(
+            "an explicit scene on several ranks: not yet (issue 42; the typed API runs the explicit solver on ranks)"
+                .into(),
+        ));
+    }
     let run = Run {
         problem,
         control,

@@ -15,6 +15,7 @@ pub mod explicit;
 pub mod explicit_law;
 pub mod implicit;
 pub mod linear;
+pub mod on_ranks;
 pub mod run;
 
 pub use explicit::{

@@ -15,6 +15,8 @@ pub use mpm_scene::material::HistoryOutput;
 
 use mpm_scene::body::Body;
 
+use crate::on_ranks::{self, RankRun};
+
 /// What sees each converged step: its number, its report and the state
 /// after it. Runs take it as a trait object, so the solver behind a run is
 /// compiled once per variant, not once more for every caller's closure.
@@ -105,6 +107,10 @@ pub struct RunControl {
     /// Attach each step's assembled stiffness to its [`Snapshot`] (for
     /// Matrix Market export).
     pub export_tangent: bool,
+    /// Run on these ranks, each with the points it is dealt; the observer
+    /// is called on rank 0 alone, with the whole problem's snapshot
+    /// ([`crate::on_ranks`]). `None`: one process.
+    pub ranks: Option<crate::on_ranks::RankRun>,
 }
 
 impl Snapshot {
@@ -311,6 +317,15 @@ where
     if let Some(linear) = external {
         solver.set_linear_solver(linear);
     }
+    let total = points.len();
+    let dealt = control
+        .ranks
+        .as_ref()
+        .map(|r| deal(r, control, &mut points));
+    let own = dealt.transpose()?;
+    if let Some(r) = &control.ranks {
+        solver.on_ranks(Box::new(r.ranks.clone()));
+    }
     let (state, earlier_time) = match &control.resume {
         Some(c) => {
             let resumed = MaterialPoints::from_flat(&c.points)?;
@@ -365,20 +380,55 @@ where
             if control.export_tangent {
                 snapshot.tangent = now.stiffness.map(|k| k.to_sprs()).transpose()?;
             }
-            observer(step, report, &snapshot)?;
+            match (&control.ranks, &own) {
+                (Some(r), Some(ids)) => on_ranks::observe_on_root(
+                    r.ranks.as_ref(),
+                    ids,
+                    &snapshot,
+                    total,
+                    &mut |whole| observer(step, report, whole),
+                )?,
+                _ => observer(step, report, &snapshot)?,
+            }
             last_mesh = snapshot.mesh_nodes.take();
             observer_time += t.elapsed().as_secs_f64();
             Ok(())
         },
     )?;
     let wall_time_s = earlier_time + start.elapsed().as_secs_f64() - observer_time;
+    let mut last = Snapshot {
+        mesh_nodes: last_mesh,
+        ..Snapshot::of(&points, 1.0)
+    };
+    if let (Some(r), Some(ids)) = (&control.ranks, &own) {
+        // Rank 0 reports the whole problem; the others their own points.
+        if let Some(whole) = on_ranks::gather(r.ranks.as_ref(), ids, &last, total)? {
+            last = whole;
+        }
+    }
     Ok(RunOutput {
-        last: Snapshot {
-            mesh_nodes: last_mesh,
-            ..Snapshot::of(&points, 1.0)
-        },
+        last,
         reports,
         summary,
         wall_time_s,
     })
+}
+
+/// Keeps this rank's points of `points` (all of the problem's, built on
+/// every rank) and returns their indices in the problem. A distributed run
+/// writes no checkpoint and resumes from none yet.
+fn deal<const D: usize, H: Copy + Default, Dom: Copy>(
+    run: &RankRun,
+    control: &RunControl,
+    points: &mut MaterialPoints<D, H, Dom>,
+) -> Result<Vec<usize>, SolverError> {
+    if control.checkpoint || control.resume.is_some() {
+        return Err(SolverError::InvalidInput(
+            "a run on several ranks writes no checkpoint and resumes from none (not yet: issue 42)"
+                .into(),
+        ));
+    }
+    let ids = run.own_points(points.len())?;
+    points.keep(&ids)?;
+    Ok(ids)
 }

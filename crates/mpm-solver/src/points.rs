@@ -111,6 +111,52 @@ impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
     pub fn set_gravity(&mut self, g: SVector<f64, D>) {
         self.body_force = self.mass.iter().map(|m| g * *m).collect();
     }
+
+    /// Keeps the points `ids` (ascending indices of this set), in that
+    /// order, with their loads: a rank's part of a point set that every
+    /// rank built whole. Point loads are renumbered and those of other
+    /// points dropped; a body-force path is asked for the kept points by
+    /// their old index.
+    ///
+    /// # Errors
+    /// [`SolverError::InvalidInput`] for indices that do not ascend or lie
+    /// beyond the set.
+    pub fn keep(&mut self, ids: &[usize]) -> Result<(), SolverError> {
+        let n = self.len();
+        let ascending = ids.windows(2).all(|w| w[0] < w[1]);
+        if !ascending || ids.last().is_some_and(|&i| i >= n) {
+            return Err(SolverError::InvalidInput(format!(
+                "the points to keep must ascend below {n}"
+            )));
+        }
+        fn pick<T: Clone>(v: &mut Vec<T>, ids: &[usize]) {
+            if !v.is_empty() {
+                *v = ids.iter().map(|&i| v[i].clone()).collect();
+            }
+        }
+        pick(&mut self.position, ids);
+        pick(&mut self.displacement, ids);
+        pick(&mut self.mass, ids);
+        pick(&mut self.volume0, ids);
+        pick(&mut self.volume, ids);
+        pick(&mut self.f, ids);
+        pick(&mut self.be, ids);
+        pick(&mut self.history, ids);
+        pick(&mut self.sigma, ids);
+        pick(&mut self.domain0, ids);
+        pick(&mut self.domain, ids);
+        pick(&mut self.body_force, ids);
+        self.point_force = (self.point_force.iter())
+            .filter_map(|&(p, f)| ids.binary_search(&p).ok().map(|k| (k, f)))
+            .collect();
+        if let Some(path) = self.body_force_path.take() {
+            let old: std::sync::Arc<[usize]> = ids.into();
+            self.body_force_path = Some(BodyForcePath(std::sync::Arc::new(move |k, lambda| {
+                (path.0)(old.get(k).copied().unwrap_or(usize::MAX), lambda)
+            })));
+        }
+        Ok(())
+    }
 }
 
 /// Checks that every volume is positive and finite and every position

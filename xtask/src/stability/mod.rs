@@ -316,6 +316,7 @@ pub fn run_scene(text: &str, case: Option<&str>, set: &[String]) -> SceneRun {
         stop_after: None,
         export_tangent: false,
         scene_dir: scenes_dir(),
+        ranks: None,
     };
     let started = Instant::now();
     let result = guarded(|| -> Result<(), CasesError> {

@@ -61,6 +61,7 @@ pub use mpm_dispatch::{explicit, explicit_law};
 pub use mpm_output::png;
 pub use mpm_scene::{SceneError, build, format, region};
 mod program;
+pub mod ranks;
 
 pub use mpm_dispatch::{
     ExplicitEvent, ExplicitFrame, ExplicitObserver, ExplicitOutput, RunExplicit, RunScene, run,

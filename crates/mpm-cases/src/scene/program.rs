@@ -2,8 +2,11 @@
 
 use serde_json::{Map, Value, json};
 
+use mpm_dispatch::on_ranks::{RankRun, SharedRanks};
+
 use crate::CasesError;
 use crate::output::CellMesh;
+use crate::run::RunControl;
 use crate::session::{Session, observer_error, summary};
 
 /// A scene file describing a whole problem (no `case` key).
@@ -42,6 +45,19 @@ where
     for w in &problem.warnings {
         eprintln!("warning: {}: {w}", source.origin());
     }
+    if let Some(shared) = &session.ranks {
+        let Some(run) = on_ranks(&problem, session, shared)? else {
+            return Ok(());
+        };
+        return match &problem.mesh {
+            crate::scene::build::SceneMesh::Grid(g) => {
+                scene_run_on(scene, &problem, session, g.clone(), Some(run))
+            }
+            crate::scene::build::SceneMesh::Simplex(m) => {
+                scene_run_on(scene, &problem, session, (**m).clone(), Some(run))
+            }
+        };
+    }
     if problem.explicit.is_some() {
         if session.export_tangent {
             return Err(CasesError::from(source.error(
@@ -60,20 +76,63 @@ where
     }
     match &problem.mesh {
         crate::scene::build::SceneMesh::Grid(g) => {
-            scene_run_on(scene, &problem, session, g.clone())
+            scene_run_on(scene, &problem, session, g.clone(), None)
         }
         crate::scene::build::SceneMesh::Simplex(m) => {
-            scene_run_on(scene, &problem, session, (**m).clone())
+            scene_run_on(scene, &problem, session, (**m).clone(), None)
         }
     }
 }
 
-/// Runs a built scene, writing its results on the mesh `mesh`.
+/// The deal of `problem` over the session's ranks, for rank 0 to run
+/// and write; `None` on the other ranks, which take their part of the run
+/// here and write nothing.
+///
+/// # Errors
+/// What a run on several ranks does not do yet (explicit scenes,
+/// checkpoints), the deal's, and the run's on the other ranks.
+fn on_ranks<const D: usize>(
+    problem: &crate::scene::Problem<D>,
+    session: &Session,
+    shared: &SharedRanks,
+) -> Result<Option<RankRun>, CasesError>
+where
+    crate::scene::Problem<D>: crate::scene::RunScene<D>,
+{
+    let refuse = |what: &str| {
+        Err(CasesError::from(mpm_solver::SolverError::InvalidInput(
+            format!("{what} on several ranks: not yet (issue 42); run it on one process"),
+        )))
+    };
+    if problem.explicit.is_some() {
+        return refuse("an explicit scene");
+    }
+    if session.resume || session.stop_after.is_some() {
+        return refuse("--resume and --stop-after (checkpoints)");
+    }
+    let run = RankRun {
+        ranks: shared.0.clone(),
+        rank_of_point: super::ranks::rank_of_point(problem, shared.0.size())?,
+    };
+    if run.is_root() {
+        return Ok(Some(run));
+    }
+    let control = RunControl {
+        ranks: Some(run),
+        ..RunControl::default()
+    };
+    crate::scene::run(problem, &control, |_, _, _| Ok(()))?;
+    Ok(None)
+}
+
+/// Runs a built scene, writing its results on the mesh `mesh`; on rank 0
+/// of a run on several ranks with `ranks`, its deal.
 fn scene_run_on<const D: usize, M: CellMesh<D>>(
     scene: &crate::scene::Scene,
     problem: &crate::scene::Problem<D>,
     session: &Session,
     mesh: M,
+    ranks: Option<RankRun>,
 ) -> Result<(), CasesError>
 where
     crate::scene::Problem<D>: crate::scene::RunScene<D>,
@@ -81,7 +140,12 @@ where
     use crate::output::CsvValue;
     use crate::writer::VtuOptions;
 
-    let (mut obs, control) = session.start(scene, mesh)?;
+    let (mut obs, mut control) = session.start(scene, mesh)?;
+    if ranks.is_some() {
+        // Checkpoints of a distributed run are not written yet.
+        control.checkpoint = false;
+        control.ranks = ranks;
+    }
     obs.writer.set_vtu_options(VtuOptions {
         every: problem.every,
         fields: problem.fields.clone(),

@@ -107,6 +107,35 @@ pub trait Ranks: Send + Sync {
     fn broadcast_text(&self, root: usize, text: &mut String) -> Result<(), RankError>;
 }
 
+/// Shared ranks are ranks: a run that keeps its communication (e.g. for
+/// gathering outputs) and hands the solver a `Box<dyn Ranks>` of it.
+impl<R: Ranks + ?Sized> Ranks for std::sync::Arc<R> {
+    fn rank(&self) -> usize {
+        (**self).rank()
+    }
+
+    fn size(&self) -> usize {
+        (**self).size()
+    }
+
+    fn exchange(
+        &self,
+        neighbours: &[usize],
+        outgoing: &[Vec<f64>],
+        incoming: &mut [Vec<f64>],
+    ) -> Result<(), RankError> {
+        (**self).exchange(neighbours, outgoing, incoming)
+    }
+
+    fn all_reduce(&self, values: &mut [f64], op: Reduce) -> Result<(), RankError> {
+        (**self).all_reduce(values, op)
+    }
+
+    fn broadcast_text(&self, root: usize, text: &mut String) -> Result<(), RankError> {
+        (**self).broadcast_text(root, text)
+    }
+}
+
 /// Who owns what: the rank of every mesh cell (its material points live
 /// there), the owner of every node (where its nodal sums meet), and this
 /// rank's neighbours (the ranks whose points may touch a node this rank's

@@ -1,0 +1,224 @@
+//! A scene's implicit run on several ranks (MPI processes, or threads in
+//! tests): every rank builds the whole problem, keeps the material points
+//! [`RankRun`] deals it, and runs the implicit solver on the ranks
+//! ([`mpm_solver::ImplicitSolver::on_ranks`]: each rank its own points, the
+//! step's system reduced, every Newton decision agreed). The snapshot the
+//! observer sees after each step is gathered onto rank 0, which alone
+//! observes (writes the outputs); whether it failed is then agreed, so an
+//! output error stops every rank with it.
+
+use std::sync::Arc;
+
+use mpm_solver::SolverError;
+use mpm_solver::ranks::{self, Ranks, Reduce};
+
+use crate::run::Snapshot;
+
+/// The ranks a program runs on, shared by its runs (a `Debug` handle).
+#[derive(Clone)]
+pub struct SharedRanks(pub Arc<dyn Ranks>);
+
+impl std::fmt::Debug for SharedRanks {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "rank {} of {}", self.0.rank(), self.0.size())
+    }
+}
+
+/// The ranks of a distributed run and which of them owns each point.
+#[derive(Clone)]
+pub struct RankRun {
+    /// The communication.
+    pub ranks: Arc<dyn Ranks>,
+    /// The rank of every material point of the problem, in the problem's
+    /// order (e.g. its cell's rank in a METIS partition; a patch's points
+    /// on one rank under F-patch).
+    pub rank_of_point: Vec<usize>,
+}
+
+impl std::fmt::Debug for RankRun {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "RankRun(rank {} of {}, {} points)",
+            self.ranks.rank(),
+            self.ranks.size(),
+            self.rank_of_point.len()
+        )
+    }
+}
+
+impl RankRun {
+    /// Whether this is rank 0, the one that observes.
+    pub fn is_root(&self) -> bool {
+        self.ranks.rank() == 0
+    }
+
+    /// The problem's indices of this rank's points, ascending.
+    ///
+    /// # Errors
+    /// [`SolverError::InvalidInput`] when the deal does not name one rank
+    /// of the run for each of the problem's `points` points.
+    pub fn own_points(&self, points: usize) -> Result<Vec<usize>, SolverError> {
+        let size = self.ranks.size();
+        if self.rank_of_point.len() != points {
+            return Err(SolverError::InvalidInput(format!(
+                "the deal names ranks for {} points, the problem has {points}",
+                self.rank_of_point.len()
+            )));
+        }
+        if let Some(r) = self.rank_of_point.iter().find(|&&r| r >= size) {
+            return Err(SolverError::InvalidInput(format!(
+                "the deal names rank {r} of a run on {size} ranks"
+            )));
+        }
+        let me = self.ranks.rank();
+        Ok((0..points)
+            .filter(|&p| self.rank_of_point[p] == me)
+            .collect())
+    }
+}
+
+/// The per-point quantities of a snapshot, as rows of one width.
+struct Rows {
+    velocity: bool,
+    domain: bool,
+}
+
+impl Rows {
+    fn width(&self) -> usize {
+        3 + 3 + 9 + 9 + 2 + 3 * usize::from(self.velocity) + 6 * usize::from(self.domain)
+    }
+
+    fn write(&self, s: &Snapshot, p: usize, out: &mut Vec<f64>) {
+        out.extend(s.position[p]);
+        out.extend(s.displacement[p]);
+        out.extend(s.sigma[p]);
+        out.extend(s.f[p]);
+        out.extend([s.volume[p], s.plastic_strain[p]]);
+        if self.velocity {
+            out.extend(s.velocity[p]);
+        }
+        if self.domain {
+            out.extend(s.domain_bounds[p].0);
+            out.extend(s.domain_bounds[p].1);
+        }
+    }
+
+    fn read(&self, row: &[f64], s: &mut Snapshot) {
+        let mut at = 0;
+        let mut take = |n: usize| {
+            let part = &row[at..at + n];
+            at += n;
+            part
+        };
+        let three = |x: &[f64]| std::array::from_fn(|i| x[i]);
+        let nine = |x: &[f64]| std::array::from_fn(|i| x[i]);
+        s.position.push(three(take(3)));
+        s.displacement.push(three(take(3)));
+        s.sigma.push(nine(take(9)));
+        s.f.push(nine(take(9)));
+        let scalars = take(2);
+        s.volume.push(scalars[0]);
+        s.plastic_strain.push(scalars[1]);
+        if self.velocity {
+            s.velocity.push(three(take(3)));
+        }
+        if self.domain {
+            let lo = three(take(3));
+            let hi = three(take(3));
+            s.domain_bounds.push((lo, hi));
+        }
+    }
+}
+
+/// The snapshot of the whole problem (`total` points, in the problem's
+/// order) on rank 0, from every rank's snapshot `local` of its points
+/// `ids`; `None` on the other ranks. Collective. The values travel as
+/// they are: the gathered snapshot holds the same bits as the ranks'.
+///
+/// # Errors
+/// The transport's, or ids that do not cover the problem once.
+pub fn gather(
+    ranks: &dyn Ranks,
+    ids: &[usize],
+    local: &Snapshot,
+    total: usize,
+) -> Result<Option<Snapshot>, SolverError> {
+    let mut flags = [
+        f64::from(u8::from(!local.velocity.is_empty())),
+        f64::from(u8::from(!local.domain_bounds.is_empty())),
+    ];
+    ranks.all_reduce(&mut flags, Reduce::Max)?;
+    let rows = Rows {
+        velocity: flags[0] > 0.0,
+        domain: flags[1] > 0.0,
+    };
+    let width = rows.width();
+    let mut message = Vec::with_capacity(1 + ids.len() * (width + 1));
+    message.push(ids.len() as f64);
+    message.extend(ids.iter().map(|&p| p as f64));
+    for p in 0..ids.len() {
+        rows.write(local, p, &mut message);
+    }
+    let (rank, size) = (ranks.rank(), ranks.size());
+    if rank != 0 {
+        let mut incoming = [Vec::new()];
+        ranks.exchange(&[0], &[message], &mut incoming)?;
+        return Ok(None);
+    }
+    let others: Vec<usize> = (1..size).collect();
+    let outgoing = vec![Vec::new(); others.len()];
+    let mut incoming = vec![Vec::new(); others.len()];
+    ranks.exchange(&others, &outgoing, &mut incoming)?;
+    let mut all = vec![f64::NAN; total * width];
+    let mut seen = vec![false; total];
+    for m in std::iter::once(&message).chain(&incoming) {
+        let n = m.first().copied().unwrap_or(0.0) as usize;
+        let (head, body) = m.split_at((1 + n).min(m.len()));
+        if body.len() != n * width {
+            return Err(gathered("a message of another length than its points"));
+        }
+        for (k, &id) in head.iter().skip(1).enumerate() {
+            let id = id as usize;
+            match seen.get_mut(id) {
+                Some(s) if !*s => *s = true,
+                _ => return Err(gathered("a point named twice or beyond the problem")),
+            }
+            all[id * width..(id + 1) * width].copy_from_slice(&body[k * width..(k + 1) * width]);
+        }
+    }
+    if seen.iter().any(|s| !s) {
+        return Err(gathered("a point of no rank"));
+    }
+    let mut whole = Snapshot {
+        load_factor: local.load_factor,
+        mesh_nodes: local.mesh_nodes.clone(),
+        tangent: local.tangent.clone(),
+        ..Snapshot::default()
+    };
+    for row in all.chunks(width) {
+        rows.read(row, &mut whole);
+    }
+    Ok(Some(whole))
+}
+
+fn gathered(what: &str) -> SolverError {
+    SolverError::InvalidInput(format!("gathering the ranks' points: {what}"))
+}
+
+/// Calls `observe` with the whole snapshot on rank 0 and agrees on its
+/// result over the ranks. Collective.
+///
+/// # Errors
+/// The observer's (on every rank), or the transport's.
+pub fn observe_on_root(
+    ranks: &dyn Ranks,
+    ids: &[usize],
+    local: &Snapshot,
+    total: usize,
+    observe: &mut dyn FnMut(&Snapshot) -> Result<(), SolverError>,
+) -> Result<(), SolverError> {
+    let whole = gather(ranks, ids, local, total)?;
+    let seen = whole.as_ref().map_or(Ok(()), observe);
+    ranks::agree(ranks, seen)
+}
