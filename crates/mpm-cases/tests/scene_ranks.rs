@@ -115,8 +115,13 @@ fn on_ranks(problem: &Problem<2>, size: usize) -> Seen {
     all.swap_remove(0)
 }
 
-fn largest(rows: &[[f64; 9]]) -> f64 {
-    rows.iter().flatten().fold(0.0, |m, x| m.max(x.abs()))
+/// The largest difference between the entries of `a` and `b`, and the
+/// largest entry of `a`.
+fn difference<const N: usize>(a: &[[f64; N]], b: &[[f64; N]]) -> (f64, f64) {
+    let pairs = a.iter().flatten().zip(b.iter().flatten());
+    pairs.fold((0.0f64, 0.0f64), |(d, m), (x, y)| {
+        (d.max((x - y).abs()), m.max(x.abs()))
+    })
 }
 
 fn compare(simplex: bool) {
@@ -135,28 +140,12 @@ fn compare(simplex: bool) {
             b.position.len(),
             "every point gathered once"
         );
-        let u_max = a
-            .displacement
-            .iter()
-            .flatten()
-            .fold(0.0f64, |m, x| m.max(x.abs()));
-        let du = a
-            .displacement
-            .iter()
-            .flatten()
-            .zip(b.displacement.iter().flatten())
-            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
         // The Newton tolerance (1e-9 on the normalised residual) bounds
         // what a different summation order may move; rounding alone moves
         // far less.
+        let (du, u_max) = difference(&a.displacement, &b.displacement);
         assert!(du <= 1e-9 * u_max, "{size} ranks: |du| {du:e} of {u_max:e}");
-        let s_max = largest(&a.sigma);
-        let ds = a
-            .sigma
-            .iter()
-            .flatten()
-            .zip(b.sigma.iter().flatten())
-            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        let (ds, s_max) = difference(&a.sigma, &b.sigma);
         assert!(ds <= 1e-8 * s_max, "{size} ranks: |dσ| {ds:e} of {s_max:e}");
         let dr = (single.reactions.iter().zip(&ranks.reactions))
             .fold(0.0f64, |m, (r1, rn)| m.max((r1 - rn).abs() / r1.abs()));
