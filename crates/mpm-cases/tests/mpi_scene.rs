@@ -124,7 +124,10 @@ fn what_the_ranks_cannot_run_yet_is_refused_on_every_process() {
     );
     let t = text(&out);
     assert!(!out.status.success(), "{t}");
-    assert!(t.contains("rank 0 of 2") && t.contains("rank 1 of 2"), "{t}");
+    assert!(
+        t.contains("rank 0 of 2") && t.contains("rank 1 of 2"),
+        "{t}"
+    );
     assert!(t.contains("on several ranks: not yet"), "{t}");
     std::fs::remove_dir_all(&root).ok();
 }
