@@ -134,6 +134,11 @@ pub struct ExplicitSummary<P: Serialize> {
     /// (total(end) − total(0)) / the largest kinetic + strain energy of the
     /// outputs.
     pub energy_drift: f64,
+    /// A run on several ranks: every new deal of the cells (`step`,
+    /// `imbalance_before`, `imbalance_after`, `points_moved`); absent when
+    /// there was none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rebalances: Vec<serde_json::Value>,
     /// Scene results (bodies, probes, the PNG).
     #[serde(flatten)]
     pub results: serde_json::Map<String, serde_json::Value>,

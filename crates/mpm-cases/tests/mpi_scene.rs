@@ -3,8 +3,10 @@
 //! writes what one process writes: the same steps, the footing's reaction
 //! in every step equal to rounding (the ranks add the same contributions
 //! in another order), the VTU series of the whole body, written by rank 0
-//! alone; a scene the ranks cannot run yet is refused on every process
-//! and the job ends.
+//! alone; so does the explicit collapsing column of
+//! `scenes/explicit_collapse.toml` on 2 processes, its energies at every
+//! output equal to rounding; what the ranks cannot run yet is refused on
+//! every process and the job ends.
 #![cfg(feature = "mpi")]
 #![allow(missing_docs, clippy::unwrap_used)]
 
@@ -16,7 +18,13 @@ use std::time::{Duration, Instant};
 const DEADLINE: Duration = Duration::from_secs(120);
 
 fn scene() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/strip_footing_ranks.toml")
+    scene_named("strip_footing_ranks.toml")
+}
+
+fn scene_named(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
 }
 
 /// Runs `mpm run` with `args` on `n` processes (`n` = 0: without mpirun).
@@ -60,7 +68,12 @@ fn text(o: &Output) -> String {
 
 /// The rows of `reaction_footing.csv` in `dir`.
 fn reactions(dir: &Path) -> Vec<Vec<f64>> {
-    let csv = std::fs::read_to_string(dir.join("reaction_footing.csv")).unwrap();
+    rows(dir, "reaction_footing.csv")
+}
+
+/// The rows of the CSV file `name` in `dir`, without its header.
+fn rows(dir: &Path, name: &str) -> Vec<Vec<f64>> {
+    let csv = std::fs::read_to_string(dir.join(name)).unwrap();
     csv.lines()
         .skip(1)
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
@@ -105,6 +118,38 @@ fn a_scene_on_2_and_3_processes_writes_what_one_process_writes() {
         assert!(worst <= 1e-8, "{n} processes: {worst:e}");
         assert_eq!(vtu_files(&dir), vtu_files(&one), "{n} processes");
     }
+    std::fs::remove_dir_all(&root).ok();
+}
+
+/// The explicit column on 2 processes: the same outputs, the energies
+/// (`energy.csv`: time, kinetic, strain, gravitational, external work,
+/// total) within 1e-10 of the largest (issue 42; the thread ranks of
+/// `tests/explicit_ranks.rs` measure 1e-15).
+#[test]
+fn an_explicit_scene_on_2_processes_writes_what_one_process_writes() {
+    let root = std::env::temp_dir().join(format!("mpm-mpi-explicit-{}", std::process::id()));
+    let scene = scene_named("explicit_collapse.toml");
+    let scene = scene.to_str().unwrap();
+    let one = root.join("one");
+    let out = mpm(0, &[scene, "--out", one.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out));
+    let two = root.join("two");
+    let out = mpm(2, &[scene, "--out", two.to_str().unwrap()]);
+    assert!(out.status.success(), "2 processes:\n{}", text(&out));
+    let (a, b) = (rows(&one, "energy.csv"), rows(&two, "energy.csv"));
+    assert_eq!(a.len(), b.len(), "the same outputs");
+    assert!(a.len() >= 10, "{a:?}");
+    let scale = (a.iter().flat_map(|r| &r[1..])).fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut worst = 0.0f64;
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x[0], y[0], "the same output times");
+        for (p, q) in x[1..].iter().zip(&y[1..]) {
+            worst = worst.max((p - q).abs() / scale);
+        }
+    }
+    eprintln!("explicit, 2 processes: energies within {worst:.1e} of the largest");
+    assert!(worst <= 1e-10, "{worst:e}");
+    assert_eq!(vtu_files(&two), vtu_files(&one));
     std::fs::remove_dir_all(&root).ok();
 }
 

@@ -13,6 +13,7 @@ mod collapse;
 mod column;
 mod coombs2020;
 mod explicit;
+mod explicit_ranks;
 mod fuzz_scenes;
 mod kill_resume;
 mod locking;

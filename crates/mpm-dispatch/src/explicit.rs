@@ -81,8 +81,11 @@ use mpm_scene::rules::Context;
 use mpm_scene::variant::{LockingKind, VariantVisitor, dispatch_in};
 
 use crate::explicit_law::{ExplicitLaw, ExplicitLaws};
+pub use crate::explicit_ranks::Rebalanced;
+use crate::explicit_ranks::{self, Spread};
 use mpm_scene::build::{ExplicitSetup, Problem, SceneMesh};
 use mpm_scene::format::TransferKind;
+use mpm_solver::ranks::Decomposition;
 
 /// What an explicit run reports to its observer.
 #[derive(Debug)]
@@ -91,6 +94,9 @@ pub enum ExplicitEvent<'a> {
     Step(StepInfo),
     /// An output time was reached (or the initial state, output 0).
     Output(ExplicitFrame<'a>),
+    /// A run on several ranks dealt its cells anew
+    /// ([`crate::on_ranks::Balance`]).
+    Rebalanced(Rebalanced),
 }
 
 /// The state of an explicit run at an output time.
@@ -220,12 +226,9 @@ fn dispatch<const D: usize>(
     control: &RunControl,
     observer: &mut ExplicitObserver<'_>,
 ) -> Result<ExplicitOutput, SolverError> {
-    parts(problem)?;
+    let (_, setup) = parts(problem)?;
     if control.ranks.is_some() {
-        return Err(SolverError::InvalidInput(
-            "an explicit scene on several ranks: not yet (issue 42; the typed API runs the explicit solver on ranks)"
-                .into(),
-        ));
+        explicit_ranks::supported(setup, control)?;
     }
     let run = Run {
         problem,
@@ -263,15 +266,17 @@ impl<const D: usize, B> SceneBasis<D> for B where
 {
 }
 
-/// A law whose point state is written to checkpoints.
-trait FlatLaw: IncrementalLaw<State: FlatState> {}
+/// A law whose point state is written to checkpoints and travels between
+/// ranks.
+trait FlatLaw: IncrementalLaw<State: FlatState + Flat> {}
 
-impl<L: IncrementalLaw<State: FlatState>> FlatLaw for L {}
+impl<L: IncrementalLaw<State: FlatState + Flat>> FlatLaw for L {}
 
-/// A velocity transfer whose point state is written to checkpoints.
-trait FlatTransfer<const D: usize>: Transfer<D, PointState: FlatState> {}
+/// A velocity transfer whose point state is written to checkpoints and
+/// travels between ranks.
+trait FlatTransfer<const D: usize>: Transfer<D, PointState: FlatState + Flat> {}
 
-impl<const D: usize, T: Transfer<D, PointState: FlatState>> FlatTransfer<D> for T {}
+impl<const D: usize, T: Transfer<D, PointState: FlatState + Flat>> FlatTransfer<D> for T {}
 
 struct Run<'a, 'o, const D: usize> {
     problem: &'a Problem<D>,
@@ -359,7 +364,7 @@ impl<const D: usize> Run<'_, '_, D> {
             time_step: setup.time_step,
             gravity: setup.gravity,
         };
-        let solver = ExplicitSolver::new(
+        let mut solver = ExplicitSolver::new(
             basis,
             grid.clone(),
             law,
@@ -369,9 +374,23 @@ impl<const D: usize> Run<'_, '_, D> {
             options,
         )?
         .with_domain_update(rule);
-        let points = initial_points::<D, B, L, T>(self.problem, setup)?;
+        let mut points = initial_points::<D, B, L, T>(self.problem, setup)?;
+        let reach = B::SUPPORT_RADIUS.ceil() as usize;
+        let spread = (self.control.ranks.as_ref())
+            .map(|run| Spread::new(run, grid, reach))
+            .transpose()?;
+        if let Some(spread) = &spread {
+            points.keep(&spread.own_points(points.len())?)?;
+            solver = solver.on_ranks(spread.ranks(), spread.initial_layout()?)?;
+        }
         let mut bound = Bound { solver, points };
-        time_loop(&mut bound, self.problem, setup, self.control, self.observer)
+        let mut out = Outputs {
+            initial_position: &self.problem.position,
+            control: self.control,
+            spread,
+            observer: self.observer,
+        };
+        time_loop(&mut bound, setup, &mut out)
     }
 }
 
@@ -379,7 +398,7 @@ impl<const D: usize> Run<'_, '_, D> {
 /// sees it. Object-safe, so that the loop, its outputs and checkpoints
 /// ([`time_loop`]) are compiled once per dimension; the solver types
 /// differ only behind it.
-trait Stepper<const D: usize> {
+pub(crate) trait Stepper<const D: usize> {
     /// The simulated time reached.
     fn time(&self) -> f64;
     /// One step of at most `max_dt`, the loads with a curve set to their
@@ -399,6 +418,17 @@ trait Stepper<const D: usize> {
     fn resume(&mut self, c: &Checkpoint, clock: &Clock) -> Result<(), SolverError>;
     /// Wall time per stage so far.
     fn stage_times(&self) -> ExplicitStageTimes;
+    /// The global ids of the points held here (their indices in the
+    /// problem).
+    fn ids(&self) -> &[usize];
+    /// On several ranks, after a step: the points that entered another
+    /// rank's cells go there ([`ExplicitSolver::migrate`]).
+    fn migrate(&mut self) -> Result<(usize, usize), SolverError>;
+    /// The points in every cell over all ranks
+    /// ([`ExplicitSolver::cell_loads`]).
+    fn cell_loads(&self) -> Result<Vec<f64>, SolverError>;
+    /// The cells dealt anew ([`ExplicitSolver::rebalance`]).
+    fn rebalance(&mut self, layout: Decomposition) -> Result<(usize, usize), SolverError>;
 }
 
 /// A typed solver with its points: the [`Stepper`] of one solver type.
@@ -481,6 +511,22 @@ where
     fn stage_times(&self) -> ExplicitStageTimes {
         *self.solver.stage_times()
     }
+
+    fn ids(&self) -> &[usize] {
+        &self.points.id
+    }
+
+    fn migrate(&mut self) -> Result<(usize, usize), SolverError> {
+        self.solver.migrate(&mut self.points)
+    }
+
+    fn cell_loads(&self) -> Result<Vec<f64>, SolverError> {
+        self.solver.cell_loads(&self.points)
+    }
+
+    fn rebalance(&mut self, layout: Decomposition) -> Result<(usize, usize), SolverError> {
+        self.solver.rebalance(&mut self.points, layout)
+    }
 }
 
 /// The scene's time loop, once per dimension: the start (or the resumed
@@ -488,10 +534,8 @@ where
 /// the outputs, the summary.
 fn time_loop<const D: usize>(
     run: &mut dyn Stepper<D>,
-    problem: &Problem<D>,
     setup: &ExplicitSetup<D>,
-    control: &RunControl,
-    observer: &mut ExplicitObserver<'_>,
+    out: &mut Outputs<'_, '_, D>,
 ) -> Result<ExplicitOutput, SolverError> {
     let outputs = output_count(setup.end_time, setup.output_interval);
     let output_time = |k: usize| {
@@ -502,12 +546,7 @@ fn time_loop<const D: usize>(
         }
     };
     let mut wall = Wall::default();
-    let mut out = Outputs {
-        initial_position: &problem.position,
-        control,
-        observer,
-    };
-    let mut clock = match &control.resume {
+    let mut clock = match &out.control.resume {
         Some(c) => {
             let clock = Clock::from_checkpoint(c)?;
             run.resume(c, &clock)?;
@@ -523,11 +562,15 @@ fn time_loop<const D: usize>(
         // the start of every step.
         while run.time() < target * (1.0 - 1e-12) {
             let info = run.step(setup, target - run.time())?;
-            wall.observe(|| (out.observer)(ExplicitEvent::Step(info)))?;
+            let balanced = out.after_step(run, info.step)?;
+            wall.observe(|| out.show(ExplicitEvent::Step(info)))?;
+            if let Some(b) = balanced {
+                wall.observe(|| out.show(ExplicitEvent::Rebalanced(b)))?;
+            }
         }
         out.output(run, &run.reached()?, &mut clock, &mut wall)?;
     }
-    let mut result = summary(run, &run.reached()?, &clock, &problem.position);
+    let mut result = out.summary(run, &run.reached()?, &clock)?;
     result.outputs = outputs + 1;
     result.wall_time_s = wall.so_far();
     let stage = run.stage_times();
@@ -580,14 +623,56 @@ where
 }
 
 /// What the outputs of a run need: the initial positions (displacements),
-/// whether to keep checkpoints, and the caller's observer.
+/// whether to keep checkpoints, the ranks of a run on several, and the
+/// caller's observer.
 struct Outputs<'a, 'o, const D: usize> {
     initial_position: &'a [SVector<f64, D>],
     control: &'a RunControl,
+    spread: Option<Spread<'a>>,
     observer: &'a mut ExplicitObserver<'o>,
 }
 
 impl<const D: usize> Outputs<'_, '_, D> {
+    /// On several ranks, after a step: the migration, and a new deal when
+    /// the work has drifted out of balance.
+    fn after_step(
+        &mut self,
+        run: &mut dyn Stepper<D>,
+        step: usize,
+    ) -> Result<Option<Rebalanced>, SolverError> {
+        match &mut self.spread {
+            Some(spread) => spread.after_step(run, step),
+            None => Ok(None),
+        }
+    }
+
+    /// Shows the observer `event`: on several ranks on rank 0 only, its
+    /// verdict agreed.
+    fn show(&mut self, event: ExplicitEvent<'_>) -> Result<(), SolverError> {
+        match &self.spread {
+            Some(spread) => spread.on_root(|| (self.observer)(event)),
+            None => (self.observer)(event),
+        }
+    }
+
+    /// The run's final state at `at`: on several ranks the points gathered
+    /// on rank 0 (the other ranks keep their own).
+    fn summary(
+        &self,
+        run: &dyn Stepper<D>,
+        at: &Reached,
+        clock: &Clock,
+    ) -> Result<ExplicitOutput, SolverError> {
+        let mut result = summary(run, at, clock, self.initial_position);
+        if let Some(spread) = &self.spread {
+            let total = self.initial_position.len();
+            if let Some(whole) = spread.gather(run.ids(), &result.last, total)? {
+                result.last = whole;
+            }
+        }
+        Ok(result)
+    }
+
     /// Output 0, the initial state with its `energies`, and the clock that
     /// starts from it.
     fn start(
@@ -639,22 +724,28 @@ impl<const D: usize> Outputs<'_, '_, D> {
         let so_far = wall.so_far();
         let (initial, control) = (self.initial_position, self.control);
         let observer = &mut *self.observer;
-        wall.observe(|| {
-            let snapshot = snapshot(run, initial, at.time, control, at.steps, clock, so_far);
+        let mut show = |snapshot: &Snapshot| {
             observer(ExplicitEvent::Output(ExplicitFrame {
                 index: clock.index,
                 time: at.time,
                 steps: at.steps,
                 energies: at.energies,
-                snapshot: &snapshot,
+                snapshot,
             }))
+        };
+        wall.observe(|| {
+            let snapshot = snapshot(run, initial, at.time, control, at.steps, clock, so_far);
+            match &self.spread {
+                Some(spread) => spread.observe_gathered(run.ids(), &snapshot, initial.len(), show),
+                None => show(&snapshot),
+            }
         })
     }
 }
 
 /// Where the solver stands at an output.
 #[derive(Debug, Clone, Copy)]
-struct Reached {
+pub(crate) struct Reached {
     time: f64,
     steps: usize,
     energies: Energies,
@@ -754,7 +845,7 @@ impl Wall {
 /// count: the output reached, the work of the applied forces, the initial
 /// energies and the energy scale (in [`Checkpoint::case_state`]).
 #[derive(Debug, Clone, Copy)]
-struct Clock {
+pub(crate) struct Clock {
     index: usize,
     external_work: f64,
     initial: Energies,
@@ -843,11 +934,10 @@ fn snapshot_of<const D: usize, S: FlatState, T: FlatState, Dom: DomainBounds<D>>
     Snapshot {
         load_factor: time,
         position: points.position.iter().map(pad).collect(),
-        displacement: points
-            .position
-            .iter()
-            .zip(initial)
-            .map(|(x, x0)| pad(&(x - x0)))
+        // By id: on several ranks a rank holds some of the points, in the
+        // order migration left them.
+        displacement: (points.position.iter().zip(&points.id))
+            .map(|(x, &id)| pad(&(x - initial[id])))
             .collect(),
         velocity: points.velocity.iter().map(pad).collect(),
         sigma: (0..points.len()).map(|p| flat(&points.cauchy(p))).collect(),

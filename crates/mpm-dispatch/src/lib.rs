@@ -13,6 +13,7 @@
 
 pub mod explicit;
 pub mod explicit_law;
+mod explicit_ranks;
 pub mod implicit;
 pub mod linear;
 pub mod on_ranks;

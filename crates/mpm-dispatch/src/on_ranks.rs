@@ -33,18 +33,74 @@ pub struct RankRun {
     /// order (e.g. its cell's rank in a METIS partition; a patch's points
     /// on one rank under F-patch).
     pub rank_of_point: Vec<usize>,
+    /// The rank of every cell of the mesh, the one holding each point in
+    /// `rank_of_point`: an explicit run's points follow their cells (they
+    /// migrate when they cross into another rank's); unused by an
+    /// implicit run, whose points stay where they were dealt.
+    pub rank_of_cell: Vec<usize>,
+    /// When an explicit run deals its cells anew; `None`: never.
+    pub balance: Option<Balance>,
 }
 
 impl std::fmt::Debug for RankRun {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "RankRun(rank {} of {}, {} points)",
+            "RankRun(rank {} of {}, {} points, {} cells)",
             self.ranks.rank(),
             self.ranks.size(),
-            self.rank_of_point.len()
+            self.rank_of_point.len(),
+            self.rank_of_cell.len()
         )
     }
+}
+
+/// The new rank of every cell from the number of points in every cell
+/// (the same answer on every rank, e.g. METIS weighted by the points).
+pub type Repartition = dyn Fn(&[f64]) -> Result<Vec<usize>, SolverError> + Send + Sync;
+
+/// How an explicit run on several ranks keeps its work balanced as the
+/// points move: every `every` steps the points per rank are counted; when
+/// the largest rank holds more than `threshold` times the mean, the cells
+/// are dealt anew by `repartition` and the points moved to their cells'
+/// new ranks.
+#[derive(Clone)]
+pub struct Balance {
+    /// Steps between measurements.
+    pub every: usize,
+    /// The imbalance (largest rank's points over the mean) that triggers
+    /// a new deal.
+    pub threshold: f64,
+    /// The new deal.
+    pub repartition: Arc<Repartition>,
+}
+
+impl std::fmt::Debug for Balance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "Balance(every {} steps past {})",
+            self.every, self.threshold
+        )
+    }
+}
+
+/// The imbalance of a deal: the points of the most loaded rank over the
+/// mean, from the points in every cell and the rank of every cell on
+/// `ranks` ranks (1 for a perfect balance; 1 when there are no points).
+pub fn imbalance(loads: &[f64], rank_of_cell: &[usize], ranks: usize) -> f64 {
+    let mut per_rank = vec![0.0; ranks.max(1)];
+    for (load, &r) in loads.iter().zip(rank_of_cell) {
+        if let Some(slot) = per_rank.get_mut(r) {
+            *slot += load;
+        }
+    }
+    let total: f64 = per_rank.iter().sum();
+    if total <= 0.0 {
+        return 1.0;
+    }
+    let most = per_rank.iter().copied().fold(0.0, f64::max);
+    most * per_rank.len() as f64 / total
 }
 
 impl RankRun {
@@ -221,4 +277,64 @@ pub fn observe_on_root(
     let whole = gather(ranks, ids, local, total)?;
     let seen = whole.as_ref().map_or(Ok(()), observe);
     ranks::agree(ranks, seen)
+}
+
+/// The ranks of a new deal `new` renamed to keep as many points as it can
+/// where the old deal `old` has them: METIS numbers its parts anew each
+/// time, and a part that holds mostly the points of old rank 3 should be
+/// rank 3 again, not move them all. Greedy on the points shared by a new
+/// part and an old rank (`loads`: the points of every cell), largest
+/// first; each name used once.
+pub fn keep_names(old: &[usize], new: &[usize], loads: &[f64], ranks: usize) -> Vec<usize> {
+    let mut shared = vec![0.0; ranks * ranks];
+    for ((&o, &n), &load) in old.iter().zip(new).zip(loads) {
+        if o < ranks && n < ranks {
+            shared[n * ranks + o] += load;
+        }
+    }
+    let mut pairs: Vec<usize> = (0..ranks * ranks).collect();
+    // Largest overlap first; ties by index, so every rank decides alike.
+    pairs.sort_by(|&a, &b| shared[b].total_cmp(&shared[a]).then(a.cmp(&b)));
+    let mut name = vec![usize::MAX; ranks];
+    let mut taken = vec![false; ranks];
+    for k in pairs {
+        let (n, o) = (k / ranks, k % ranks);
+        if name[n] == usize::MAX && !taken[o] {
+            name[n] = o;
+            taken[o] = true;
+        }
+    }
+    new.iter()
+        .map(|&n| name.get(n).copied().unwrap_or(n))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{imbalance, keep_names};
+
+    #[test]
+    fn a_new_deal_keeps_the_names_of_the_ranks_whose_points_it_keeps() {
+        // The old deal: cells 0, 1 on rank 0, cells 2, 3 on rank 1; the
+        // new one moves cell 1 and swaps the names.
+        let old = [0, 0, 1, 1];
+        let new = [1, 0, 0, 0];
+        let loads = [4.0, 1.0, 3.0, 3.0];
+        // New part 1 holds rank 0's 4 points, new part 0 rank 1's 6 (and
+        // 1 of rank 0's): renamed, only cell 1's point moves.
+        assert_eq!(keep_names(&old, &new, &loads, 2), [0, 1, 1, 1]);
+        // The same deal under the same names stays.
+        assert_eq!(keep_names(&old, &old, &loads, 2), old);
+    }
+
+    #[test]
+    fn the_imbalance_is_the_largest_ranks_points_over_the_mean() {
+        // Cells of 4, 0, 2 and 2 points on ranks 0, 0, 1, 1: 4 and 4.
+        assert_eq!(imbalance(&[4.0, 0.0, 2.0, 2.0], &[0, 0, 1, 1], 2), 1.0);
+        // 6 and 2 points: the mean is 4, the largest 6.
+        assert_eq!(imbalance(&[4.0, 2.0, 0.0, 2.0], &[0, 0, 1, 1], 2), 1.5);
+        // A rank without cells counts in the mean.
+        assert_eq!(imbalance(&[1.0, 1.0], &[0, 0], 2), 2.0);
+        assert_eq!(imbalance(&[0.0, 0.0], &[0, 1], 2), 1.0);
+    }
 }

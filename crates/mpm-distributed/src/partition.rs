@@ -107,6 +107,39 @@ pub struct HaloPlan {
 /// [`PartitionError`] for no rank or more ranks than units, an
 /// inconsistent mesh, or METIS's failure.
 pub fn partition(mesh: &MeshView<'_>, ranks: usize) -> Result<Partition, PartitionError> {
+    let units = units(mesh, ranks)?;
+    let weights = unit_weights(mesh, units);
+    partition_with(mesh, units, &weights, ranks)
+}
+
+/// Partitions `mesh` over `ranks` with the given `weights` of its units
+/// instead of their points and nodes: e.g. during an explicit run the
+/// points in every cell plus one (the work that moves with the points;
+/// the one keeps an empty cell placeable). Its points are those of
+/// `mesh.element_of_point`.
+///
+/// # Errors
+/// As [`partition`], and a weight per unit missing.
+pub fn partition_weighted(
+    mesh: &MeshView<'_>,
+    weights: &[usize],
+    ranks: usize,
+) -> Result<Partition, PartitionError> {
+    let units = units(mesh, ranks)?;
+    if weights.len() != units {
+        return Err(PartitionError::Mesh(format!(
+            "{} weights for {units} units",
+            weights.len()
+        )));
+    }
+    let weights: Vec<metis::Idx> = (weights.iter())
+        .map(|&w| metis::Idx::try_from(w).unwrap_or(metis::Idx::MAX))
+        .collect();
+    partition_with(mesh, units, &weights, ranks)
+}
+
+/// The number of units of a valid `mesh` that `ranks` ranks can share.
+fn units(mesh: &MeshView<'_>, ranks: usize) -> Result<usize, PartitionError> {
     check(mesh)?;
     let units = mesh
         .unit_of_element
@@ -114,12 +147,20 @@ pub fn partition(mesh: &MeshView<'_>, ranks: usize) -> Result<Partition, Partiti
     if ranks == 0 || ranks > units {
         return Err(PartitionError::Ranks { units, ranks });
     }
+    Ok(units)
+}
+
+fn partition_with(
+    mesh: &MeshView<'_>,
+    units: usize,
+    weights: &[metis::Idx],
+    ranks: usize,
+) -> Result<Partition, PartitionError> {
     let (xadj, adjncy) = dual_graph(mesh, units);
-    let weights = unit_weights(mesh, units);
     let (rank_of_unit, edge_cut) = if ranks == 1 {
         (vec![0; units], 0)
     } else {
-        metis_kway(&xadj, &adjncy, &weights, ranks)?
+        metis_kway(&xadj, &adjncy, weights, ranks)?
     };
     let rank_of_element: Vec<usize> = (0..mesh.elements())
         .map(|e| rank_of_unit[mesh.unit(e)])

@@ -122,13 +122,7 @@ impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
     /// [`SolverError::InvalidInput`] for indices that do not ascend or lie
     /// beyond the set.
     pub fn keep(&mut self, ids: &[usize]) -> Result<(), SolverError> {
-        let n = self.len();
-        let ascending = ids.windows(2).all(|w| w[0] < w[1]);
-        if !ascending || ids.last().is_some_and(|&i| i >= n) {
-            return Err(SolverError::InvalidInput(format!(
-                "the points to keep must ascend below {n}"
-            )));
-        }
+        check_kept(ids, self.len())?;
         fn pick<T: Clone>(v: &mut Vec<T>, ids: &[usize]) {
             if !v.is_empty() {
                 *v = ids.iter().map(|&i| v[i].clone()).collect();
@@ -157,6 +151,17 @@ impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
         }
         Ok(())
     }
+}
+
+/// Checks that the indices `ids` of points to keep ascend below `n`.
+pub(crate) fn check_kept(ids: &[usize], n: usize) -> Result<(), SolverError> {
+    let ascending = ids.windows(2).all(|w| w[0] < w[1]);
+    if !ascending || ids.last().is_some_and(|&i| i >= n) {
+        return Err(SolverError::InvalidInput(format!(
+            "the points to keep must ascend below {n}"
+        )));
+    }
+    Ok(())
 }
 
 /// Checks that every volume is positive and finite and every position

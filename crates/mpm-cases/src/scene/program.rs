@@ -49,6 +49,16 @@ where
         let Some(run) = on_ranks(&problem, session, shared)? else {
             return Ok(());
         };
+        if problem.explicit.is_some() {
+            return match &problem.mesh {
+                crate::scene::build::SceneMesh::Grid(g) => {
+                    explicit_run_on(scene, &problem, session, g.clone(), Some(run))
+                }
+                crate::scene::build::SceneMesh::Simplex(_) => Err(source
+                    .error(None, "the explicit solver runs on regular grids")
+                    .into()),
+            };
+        }
         return match &problem.mesh {
             crate::scene::build::SceneMesh::Grid(g) => {
                 scene_run_on(scene, &problem, session, g.clone(), Some(run))
@@ -67,7 +77,7 @@ where
         }
         return match &problem.mesh {
             crate::scene::build::SceneMesh::Grid(g) => {
-                explicit_run_on(scene, &problem, session, g.clone())
+                explicit_run_on(scene, &problem, session, g.clone(), None)
             }
             crate::scene::build::SceneMesh::Simplex(_) => Err(source
                 .error(None, "the explicit solver runs on regular grids")
@@ -89,31 +99,22 @@ where
 /// here and write nothing.
 ///
 /// # Errors
-/// What a run on several ranks does not do yet (explicit scenes,
-/// checkpoints), the deal's, and the run's on the other ranks.
+/// What a run on several ranks does not do yet (checkpoints), the
+/// deal's, and the run's on the other ranks.
 fn on_ranks<const D: usize>(
     problem: &crate::scene::Problem<D>,
     session: &Session,
     shared: &SharedRanks,
 ) -> Result<Option<RankRun>, CasesError>
 where
-    crate::scene::Problem<D>: crate::scene::RunScene<D>,
+    crate::scene::Problem<D>: crate::scene::RunScene<D> + crate::scene::RunExplicit<D>,
 {
-    let refuse = |what: &str| {
-        Err(CasesError::from(mpm_solver::SolverError::InvalidInput(
-            format!("{what} on several ranks: not yet (issue 42); run it on one process"),
-        )))
-    };
-    if problem.explicit.is_some() {
-        return refuse("an explicit scene");
-    }
     if session.resume || session.stop_after.is_some() {
-        return refuse("--resume and --stop-after (checkpoints)");
+        return Err(CasesError::from(mpm_solver::SolverError::InvalidInput(
+            "--resume and --stop-after (checkpoints) on several ranks: not yet (issue 42); run it on one process".into(),
+        )));
     }
-    let run = RankRun {
-        ranks: shared.0.clone(),
-        rank_of_point: super::ranks::rank_of_point(problem, shared.0.size())?,
-    };
+    let run = super::ranks::rank_run(problem, shared.0.clone())?;
     if run.is_root() {
         return Ok(Some(run));
     }
@@ -121,7 +122,11 @@ where
         ranks: Some(run),
         ..RunControl::default()
     };
-    crate::scene::run(problem, &control, |_, _, _| Ok(()))?;
+    if problem.explicit.is_some() {
+        crate::scene::run_explicit(problem, &control, |_| Ok(()))?;
+    } else {
+        crate::scene::run(problem, &control, |_, _, _| Ok(()))?;
+    }
     Ok(None)
 }
 
@@ -309,12 +314,15 @@ fn energies_json(e: &mpm_solver::explicit::Energies) -> Value {
 
 /// Runs a built explicit scene on its grid: the VTU series and a row of
 /// `energy.csv` (and of every probe's history) at every output time, a
-/// checkpoint with each output, `summary.json` at the end.
+/// checkpoint with each output, `summary.json` at the end; on rank 0 of a
+/// run on several ranks with `ranks`, its deal (no checkpoints; the new
+/// deals of the cells in `summary.json`).
 fn explicit_run_on<const D: usize>(
     scene: &crate::scene::Scene,
     problem: &crate::scene::Problem<D>,
     session: &Session,
     grid: mpm_mesh::RegularGrid<D>,
+    ranks: Option<RankRun>,
 ) -> Result<(), CasesError>
 where
     crate::scene::Problem<D>: crate::scene::RunExplicit<D>,
@@ -329,7 +337,13 @@ where
         )));
     };
     let end_time = setup.end_time;
-    let (mut obs, control) = session.start(scene, grid)?;
+    let (mut obs, mut control) = session.start(scene, grid)?;
+    if ranks.is_some() {
+        // Checkpoints of a distributed run are not written yet.
+        control.checkpoint = false;
+        control.ranks = ranks;
+    }
+    let mut rebalances = Vec::new();
     obs.show_time();
     obs.writer.set_vtu_options(VtuOptions {
         every: 1,
@@ -353,6 +367,15 @@ where
     let run = crate::scene::run_explicit(problem, &control, |event| match event {
         ExplicitEvent::Step(info) => {
             obs.explicit_step(info.time, end_time, info.step, info.dt);
+            Ok(())
+        }
+        ExplicitEvent::Rebalanced(b) => {
+            rebalances.push(json!({
+                "step": b.step,
+                "imbalance_before": b.before,
+                "imbalance_after": b.after,
+                "points_moved": b.moved,
+            }));
             Ok(())
         }
         ExplicitEvent::Output(frame) => {
@@ -418,6 +441,7 @@ where
         initial_energies: energies_json(&r.initial),
         final_energies: energies_json(&r.last_energies),
         energy_drift: r.energy_drift,
+        rebalances,
         results,
         parameters: scene,
     };

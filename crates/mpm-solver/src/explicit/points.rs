@@ -74,6 +74,46 @@ impl<const D: usize, S, T, Dom> ExplicitPoints<D, S, T, Dom> {
     pub fn cauchy(&self, p: usize) -> Matrix3<f64> {
         self.tau[p] / self.f[p].determinant()
     }
+
+    /// Keeps the points at the indices `ids` (ascending), in that order,
+    /// with their ids: a rank's part of a point set that every rank built
+    /// whole. Point forces and fixities are renumbered and those of other
+    /// points dropped.
+    ///
+    /// # Errors
+    /// [`SolverError::InvalidInput`] for indices that do not ascend or lie
+    /// beyond the set.
+    pub fn keep(&mut self, ids: &[usize]) -> Result<(), SolverError>
+    where
+        S: Clone,
+        T: Clone,
+        Dom: Clone,
+    {
+        crate::points::check_kept(ids, self.len())?;
+        fn pick<X: Clone>(v: &mut Vec<X>, ids: &[usize]) {
+            *v = ids.iter().map(|&i| v[i].clone()).collect();
+        }
+        pick(&mut self.id, ids);
+        pick(&mut self.position, ids);
+        pick(&mut self.velocity, ids);
+        pick(&mut self.mass, ids);
+        pick(&mut self.volume0, ids);
+        pick(&mut self.volume, ids);
+        pick(&mut self.f, ids);
+        pick(&mut self.tau, ids);
+        pick(&mut self.material, ids);
+        pick(&mut self.transfer, ids);
+        pick(&mut self.domain, ids);
+        pick(&mut self.domain0, ids);
+        let at = |p: usize| ids.binary_search(&p).ok();
+        self.point_force = (self.point_force.iter())
+            .filter_map(|&(p, f)| at(p).map(|k| (k, f)))
+            .collect();
+        self.fixed_velocity = (self.fixed_velocity.iter())
+            .filter_map(|&(p, axis, v)| at(p).map(|k| (k, axis, v)))
+            .collect();
+        Ok(())
+    }
 }
 
 impl<const D: usize, S: Copy + Default, T: Copy + Default> ExplicitPoints<D, S, T> {
@@ -152,5 +192,31 @@ impl<const D: usize, S: Copy + Default, T: Copy + Default> ExplicitPoints<D, S, 
             domain0: vec![(); n],
             position,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector2;
+
+    use super::ExplicitPoints;
+
+    #[test]
+    fn keeping_points_keeps_their_ids_state_forces_and_fixities() {
+        let x = (0..4).map(|i| Vector2::new(f64::from(i), 0.0)).collect();
+        let mut points: ExplicitPoints<2, u8, ()> =
+            ExplicitPoints::new(x, vec![1.0; 4], 2.0).expect("points");
+        points.material = vec![10, 11, 12, 13];
+        points.point_force = vec![(1, Vector2::new(1.0, 0.0)), (2, Vector2::new(2.0, 0.0))];
+        points.fixed_velocity = vec![(3, 1, 0.5), (0, 0, 0.0)];
+        points.keep(&[1, 3]).expect("kept");
+        assert_eq!(points.id, [1, 3]);
+        assert_eq!(points.position[1], Vector2::new(3.0, 0.0));
+        assert_eq!(points.material, [11, 13]);
+        assert_eq!(points.mass, [2.0, 2.0]);
+        assert_eq!(points.point_force, [(0, Vector2::new(1.0, 0.0))]);
+        assert_eq!(points.fixed_velocity, [(1, 1, 0.5)]);
+        assert!(points.keep(&[1, 0]).is_err(), "not ascending");
+        assert!(points.keep(&[2]).is_err(), "beyond the set");
     }
 }

@@ -1,0 +1,148 @@
+//! An explicit scene on several ranks through the scene runner
+//! (`RunControl::ranks`, what `mpirun -n N mpm run` does over MPI), here
+//! on threads: the collapsing column of `scenes/explicit_collapse.toml`,
+//! which is not symmetric about any cut, about 1,000 steps with points
+//! crossing between ranks and the cells dealt anew as the column spreads.
+//! One rank is the one process bit for bit; on 2 and 4 ranks the sums
+//! over the nodes are added in another order, so the runs differ by
+//! rounding only: issue 42's bounds (positions within 1e-10 h, stresses
+//! 1e-9 of the largest, energies 1e-10) are far above it and far below
+//! any error of the method.
+
+use std::sync::Arc;
+
+use mpm_cases::run::{RunControl, Snapshot};
+use mpm_cases::scene::{self, ExplicitEvent, Problem};
+use mpm_dispatch::explicit::Rebalanced;
+use mpm_solver::explicit::Energies;
+use mpm_solver::ranks::ThreadRanks;
+
+const COLLAPSE: &str = include_str!("../../../scenes/explicit_collapse.toml");
+
+/// The cell size of the scene (m).
+const H: f64 = 1.0 / 16.0;
+
+/// What rank 0 saw.
+#[derive(Debug, Default)]
+struct Seen {
+    snapshots: Vec<Snapshot>,
+    energies: Vec<Energies>,
+    steps: usize,
+    rebalances: Vec<Rebalanced>,
+}
+
+fn problem() -> Problem<2> {
+    let (scene, source) = scene::parse(COLLAPSE, "explicit_collapse.toml", &[]).unwrap();
+    Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap()
+}
+
+fn run_with(problem: &Problem<2>, control: &RunControl) -> Seen {
+    let mut seen = Seen::default();
+    let out = scene::run_explicit(problem, control, |event| {
+        match event {
+            ExplicitEvent::Output(frame) => {
+                seen.snapshots.push(frame.snapshot.clone());
+                seen.energies.push(frame.energies);
+            }
+            ExplicitEvent::Rebalanced(b) => seen.rebalances.push(b),
+            ExplicitEvent::Step(_) => {}
+        }
+        Ok(())
+    })
+    .unwrap();
+    seen.steps = out.steps;
+    seen
+}
+
+fn on_ranks(problem: &Problem<2>, size: usize) -> Seen {
+    let mut all = ThreadRanks::run(size, |ranks| {
+        let mut run = mpm_cases::scene::ranks::rank_run(problem, Arc::new(ranks)).unwrap();
+        // A stricter balance than the program's, so that the deal changes
+        // within the run as the column spreads.
+        run.balance.as_mut().unwrap().threshold = 1.02;
+        run_with(
+            problem,
+            &RunControl {
+                ranks: Some(run),
+                ..RunControl::default()
+            },
+        )
+    });
+    for other in &all[1..] {
+        assert!(other.snapshots.is_empty(), "only rank 0 observes");
+        assert_eq!(other.steps, all[0].steps, "every rank takes every step");
+    }
+    all.swap_remove(0)
+}
+
+/// The largest difference between the entries of `a` and `b`, and the
+/// largest entry of `a`.
+fn difference<const N: usize>(a: &[[f64; N]], b: &[[f64; N]]) -> (f64, f64) {
+    let pairs = a.iter().flatten().zip(b.iter().flatten());
+    pairs.fold((0.0f64, 0.0f64), |(d, m), (x, y)| {
+        (d.max((x - y).abs()), m.max(x.abs()))
+    })
+}
+
+/// The largest difference of the energies over the outputs, relative to
+/// the largest of their parts.
+fn energy_difference(a: &[Energies], b: &[Energies]) -> f64 {
+    let parts = |e: &Energies| [e.kinetic, e.strain, e.gravitational, e.external_work];
+    let scale = (a.iter().flat_map(parts)).fold(0.0f64, |m, x| m.max(x.abs()));
+    let d = (a.iter().zip(b)).flat_map(|(x, y)| {
+        let (x, y) = (parts(x), parts(y));
+        (0..4).map(move |k| (x[k] - y[k]).abs())
+    });
+    d.fold(0.0f64, f64::max) / scale
+}
+
+#[test]
+fn the_collapsing_column_on_ranks_equals_one_process() {
+    let problem = problem();
+    let single = run_with(&problem, &RunControl::default());
+    assert!(single.steps >= 500, "{} steps", single.steps);
+    // The column spreads: its toe moves well beyond its start at x = 1 m.
+    let last = single.snapshots.last().unwrap();
+    let toe = last.position.iter().fold(0.0f64, |m, x| m.max(x[0]));
+    assert!(toe > 1.0 + 4.0 * H, "toe at {toe} m");
+
+    let one = on_ranks(&problem, 1);
+    assert_eq!(one.steps, single.steps);
+    assert_eq!(one.energies, single.energies, "1 rank");
+    for (a, b) in single.snapshots.iter().zip(&one.snapshots) {
+        assert_eq!(a.position, b.position, "1 rank, bit for bit");
+        assert_eq!(a.velocity, b.velocity, "1 rank, bit for bit");
+        assert_eq!(a.sigma, b.sigma, "1 rank, bit for bit");
+    }
+
+    for size in [2, 4] {
+        let ranks = on_ranks(&problem, size);
+        assert_eq!(ranks.steps, single.steps, "{size} ranks");
+        assert_eq!(ranks.snapshots.len(), single.snapshots.len());
+        let (mut dx, mut ds, mut s_max) = (0.0f64, 0.0f64, 0.0f64);
+        for (a, b) in single.snapshots.iter().zip(&ranks.snapshots) {
+            assert_eq!(a.position.len(), b.position.len(), "every point once");
+            dx = dx.max(difference(&a.position, &b.position).0);
+            let (d, m) = difference(&a.sigma, &b.sigma);
+            (ds, s_max) = (ds.max(d), s_max.max(m));
+        }
+        let de = energy_difference(&single.energies, &ranks.energies);
+        eprintln!(
+            "{size} ranks, {} steps: |dx| {:.1e} h, |dσ| {:.1e} of max |σ|, energies {de:.1e}; new deals {:?}",
+            ranks.steps,
+            dx / H,
+            ds / s_max,
+            ranks.rebalances
+        );
+        assert!(dx <= 1e-10 * H, "{size} ranks: |dx| {dx:e}");
+        assert!(ds <= 1e-9 * s_max, "{size} ranks: |dσ| {ds:e} of {s_max:e}");
+        assert!(de <= 1e-10, "{size} ranks: energies {de:e}");
+        assert!(
+            !ranks.rebalances.is_empty(),
+            "{size} ranks: the spreading column is dealt anew"
+        );
+        for b in &ranks.rebalances {
+            assert!(b.after < b.before && b.moved > 0, "{b:?}");
+        }
+    }
+}
