@@ -5,13 +5,21 @@
 //! in another order), the VTU series of the whole body, written by rank 0
 //! alone; so does the explicit collapsing column of
 //! `scenes/explicit_collapse.toml` on 2 processes, its energies at every
-//! output equal to rounding; what the ranks cannot run yet is refused on
-//! every process and the job ends.
+//! output equal to rounding. A job killed (its whole process group, with
+//! SIGKILL) after a few steps leaves no process behind and, resumed on the
+//! same number of processes, writes the files of the uninterrupted job
+//! byte for byte; resumed on another number, the same steps with the
+//! reactions equal to rounding. What the ranks cannot run yet is refused
+//! on every process and the job ends.
 #![cfg(feature = "mpi")]
 #![allow(missing_docs, clippy::unwrap_used)]
 
+#[path = "common/mod.rs"]
+mod common;
+
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// A job that has not ended in this time hangs.
@@ -27,8 +35,9 @@ fn scene_named(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// Runs `mpm run` with `args` on `n` processes (`n` = 0: without mpirun).
-fn mpm(n: usize, args: &[&str]) -> Output {
+/// Starts `mpm run` with `args` on `n` processes (`n` = 0: without
+/// mpirun), in a process group of its own.
+fn start(n: usize, args: &[&str]) -> Child {
     let exe = env!("CARGO_BIN_EXE_mpm");
     let mut command = if n == 0 {
         Command::new(exe)
@@ -37,7 +46,7 @@ fn mpm(n: usize, args: &[&str]) -> Output {
         c.args(["-n", &n.to_string(), "--oversubscribe", exe]);
         c
     };
-    let mut child = command
+    command
         .arg("run")
         .args(args)
         .env("RAYON_NUM_THREADS", "1")
@@ -45,8 +54,14 @@ fn mpm(n: usize, args: &[&str]) -> Output {
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
+        .process_group(0)
         .spawn()
-        .expect("mpirun (Open MPI) must be installed for the mpi feature's tests");
+        .expect("mpirun (Open MPI) must be installed for the mpi feature's tests")
+}
+
+/// Runs `mpm run` with `args` on `n` processes (`n` = 0: without mpirun).
+fn mpm(n: usize, args: &[&str]) -> Output {
+    let mut child = start(n, args);
     let start = Instant::now();
     while child.try_wait().unwrap().is_none() {
         if start.elapsed() > DEADLINE {
@@ -153,10 +168,135 @@ fn an_explicit_scene_on_2_processes_writes_what_one_process_writes() {
     std::fs::remove_dir_all(&root).ok();
 }
 
+/// Whether any process of group `group` is alive.
+fn group_alive(group: u32) -> bool {
+    Command::new("kill")
+        .args(["-s", "0", "--", &format!("-{group}")])
+        .stderr(Stdio::null())
+        .status()
+        .unwrap()
+        .success()
+}
+
+/// The files of a finished run that do not depend on the wall clock:
+/// every file but the checkpoint and `summary.json`, `steps.csv` without
+/// its `seconds*` columns.
+fn outputs(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let mut files = common::run_outputs(dir);
+    let steps = String::from_utf8(files["steps.csv"].clone()).unwrap();
+    files.insert(
+        "steps.csv".into(),
+        common::without_timings(&steps).into_bytes(),
+    );
+    files
+}
+
+/// The strip footing in 30 steps on 2 processes, killed once its
+/// checkpoint holds 3 steps, resumed with `--resume` on 2 processes: the
+/// uninterrupted job's files byte for byte (so too when stopped with
+/// `--stop-after 2`); from the same checkpoint on 3 processes: the same
+/// steps, reactions within 1e-8.
+#[test]
+fn a_job_killed_and_resumed_writes_the_uninterrupted_files() {
+    let root = std::env::temp_dir().join(format!("mpm-mpi-kill-{}", std::process::id()));
+    let scene = scene();
+    let scene = scene.to_str().unwrap();
+    let args = |dir: &Path| {
+        vec![
+            scene.to_string(),
+            "--set".into(),
+            "solver.steps=30".into(),
+            "--out".into(),
+            dir.to_str().unwrap().to_string(),
+        ]
+    };
+    let run = |n: usize, dir: &Path, more: &[&str]| {
+        let mut a = args(dir);
+        a.extend(more.iter().map(|s| s.to_string()));
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        let out = mpm(n, &a);
+        assert!(out.status.success(), "{n} processes:\n{}", text(&out));
+    };
+    let reference = root.join("reference");
+    run(2, &reference, &[]);
+
+    let killed = root.join("killed");
+    let a = args(&killed);
+    let a: Vec<&str> = a.iter().map(String::as_str).collect();
+    let mut job = start(2, &a);
+    let group = job.id();
+    let begun = Instant::now();
+    loop {
+        let steps = mpm_cases::checkpoint::read(&killed).map_or(0, |(h, _)| h.steps);
+        if steps >= 3 {
+            break;
+        }
+        assert!(
+            job.try_wait().unwrap().is_none(),
+            "the job ended before it was killed"
+        );
+        assert!(begun.elapsed() < DEADLINE, "no checkpoint of 3 steps");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let killed_at = Instant::now();
+    Command::new("kill")
+        .args(["-s", "KILL", "--", &format!("-{group}")])
+        .status()
+        .unwrap();
+    job.wait().unwrap();
+    while group_alive(group) {
+        assert!(
+            killed_at.elapsed() < Duration::from_secs(5),
+            "processes of the killed job are left"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let steps = mpm_cases::checkpoint::read(&killed).unwrap().0.steps;
+    assert!(steps < 30, "killed mid-run: {steps} steps");
+    let on_three = root.join("on_three");
+    std::fs::create_dir_all(&on_three).unwrap();
+    std::fs::copy(
+        killed.join("checkpoint.mpm"),
+        on_three.join("checkpoint.mpm"),
+    )
+    .unwrap();
+    run(2, &killed, &["--resume"]);
+    eprintln!("killed after {steps} of 30 steps, resumed on 2 processes");
+    assert_eq!(
+        outputs(&killed),
+        outputs(&reference),
+        "resumed on 2 processes"
+    );
+
+    // Stopped by rank 0 after 2 steps (`--stop-after`), every process
+    // ends without error; resumed, the same files again.
+    let stopped = root.join("stopped");
+    run(2, &stopped, &["--stop-after", "2"]);
+    assert_eq!(mpm_cases::checkpoint::read(&stopped).unwrap().0.steps, 2);
+    run(2, &stopped, &["--resume"]);
+    assert_eq!(outputs(&stopped), outputs(&reference), "stopped and resumed");
+
+    run(3, &on_three, &["--resume"]);
+    let (a, b) = (reactions(&reference), reactions(&on_three));
+    let b = &b[b.len() - (30 - steps)..];
+    let a = &a[a.len() - (30 - steps)..];
+    let mut worst = 0.0f64;
+    for (x, y) in a.iter().zip(b) {
+        assert_eq!(x[0], y[0], "the same load factors");
+        let scale = x[1..].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (p, q) in x[1..].iter().zip(&y[1..]) {
+            worst = worst.max((p - q).abs() / scale);
+        }
+    }
+    eprintln!("resumed on 3 processes: reactions within {worst:.1e}");
+    assert!(worst <= 1e-8, "{worst:e}");
+    std::fs::remove_dir_all(&root).ok();
+}
+
 #[test]
 fn what_the_ranks_cannot_run_yet_is_refused_on_every_process() {
     let root = std::env::temp_dir().join(format!("mpm-mpi-refuse-{}", std::process::id()));
-    let scene = scene();
+    let scene = scene_named("explicit_collapse.toml");
     let out = mpm(
         2,
         &[

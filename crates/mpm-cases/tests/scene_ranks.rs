@@ -159,11 +159,19 @@ fn on_ranks<const D: usize>(problem: &Problem<D>, size: usize) -> Seen
 where
     Problem<D>: RunScene<D>,
 {
+    on_ranks_with(problem, size, &RunControl::default())
+}
+
+/// As [`on_ranks`], the run driven by `control` (checkpoints, resumption).
+fn on_ranks_with<const D: usize>(problem: &Problem<D>, size: usize, control: &RunControl) -> Seen
+where
+    Problem<D>: RunScene<D>,
+{
     let mut all = ThreadRanks::run(size, |ranks| {
         let run = mpm_cases::scene::ranks::rank_run(problem, Arc::new(ranks)).unwrap();
         let control = RunControl {
             ranks: Some(run),
-            ..RunControl::default()
+            ..control.clone()
         };
         run_with(problem, &control)
     });
@@ -272,6 +280,60 @@ fn the_f_patch_notched_plate_on_ranks_equals_one_process() {
         ],
     );
     compare("notched plate F-patch", &plate);
+}
+
+/// A checkpoint of a run on ranks holds the whole problem's points, so
+/// it resumes on the same ranks bit for bit, and on other ranks or one
+/// process as a run on those would go on (within rounding); a one-process
+/// checkpoint resumes on ranks alike.
+#[test]
+fn a_checkpoint_on_ranks_resumes_on_any_number_of_ranks() {
+    let footing = scene_file::<2>("strip_footing_ranks.toml", &[]);
+    let keep = RunControl {
+        checkpoint: true,
+        ..RunControl::default()
+    };
+    let whole = on_ranks_with(&footing, 2, &keep);
+    let after_two = whole.snapshots[1].checkpoint.clone().unwrap();
+    let resume = RunControl {
+        resume: Some(after_two.clone()),
+        ..RunControl::default()
+    };
+    let again = on_ranks_with(&footing, 2, &resume);
+    let rest = &whole.snapshots[2..];
+    assert_eq!(
+        again.snapshots.len(),
+        rest.len(),
+        "the steps after the second"
+    );
+    for (a, b) in rest.iter().zip(&again.snapshots) {
+        assert_eq!(a.displacement, b.displacement, "2 ranks, resumed on 2");
+        assert_eq!(a.sigma, b.sigma, "2 ranks, resumed on 2");
+    }
+    assert_eq!(again.iterations, whole.iterations[2..]);
+    let tolerance = footing.newton.tolerance;
+    let tail = |s: &Seen| Seen {
+        snapshots: s.snapshots[2..].to_vec(),
+        iterations: s.iterations[2..].to_vec(),
+        reactions: s.reactions[2..].to_vec(),
+    };
+    let on_three = on_ranks_with(&footing, 3, &resume);
+    close("resumed on 3 ranks", 3, tolerance, &tail(&whole), &on_three);
+    let single = run_with(&footing, &resume);
+    close("resumed on 1 process", 1, tolerance, &tail(&whole), &single);
+    let one_process = run_with(&footing, &keep);
+    let resume_single = RunControl {
+        resume: one_process.snapshots[1].checkpoint.clone(),
+        ..RunControl::default()
+    };
+    let on_two = on_ranks_with(&footing, 2, &resume_single);
+    close(
+        "one process's, resumed on 2 ranks",
+        2,
+        tolerance,
+        &tail(&one_process),
+        &on_two,
+    );
 }
 
 #[test]

@@ -246,10 +246,13 @@ pub fn gather(
     if seen.iter().any(|s| !s) {
         return Err(gathered("a point of no rank"));
     }
+    // Rank 0's checkpoint, when the run keeps them, is the whole
+    // problem's already (the ranks' parts joined when it was made).
     let mut whole = Snapshot {
         load_factor: local.load_factor,
         mesh_nodes: local.mesh_nodes.clone(),
         tangent: local.tangent.clone(),
+        checkpoint: local.checkpoint.clone(),
         ..Snapshot::default()
     };
     for row in all.chunks(width) {

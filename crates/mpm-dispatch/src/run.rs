@@ -16,6 +16,7 @@ pub use mpm_scene::material::HistoryOutput;
 use mpm_scene::body::Body;
 
 use crate::on_ranks::{self, RankRun};
+use mpm_solver::ranks;
 
 /// What sees each converged step: its number, its report and the state
 /// after it. Runs take it as a trait object, so the solver behind a run is
@@ -318,33 +319,22 @@ where
         solver.set_linear_solver(linear);
     }
     let total = points.len();
-    let dealt = control
-        .ranks
-        .as_ref()
-        .map(|r| deal(r, control, &mut points));
-    let own = dealt.transpose()?;
-    if let Some(r) = &control.ranks {
-        solver.on_ranks(Box::new(r.ranks.clone()));
-    }
+    // A checkpoint holds the whole problem's points (joined from the ranks'
+    // parts when written on several), so it resumes on any number of
+    // ranks: restored whole, then dealt as at the start.
     let (state, earlier_time) = match &control.resume {
         Some(c) => {
-            let resumed = MaterialPoints::from_flat(&c.points)?;
-            if resumed.len() != points.len() {
-                return Err(SolverError::InvalidInput(format!(
-                    "the checkpoint holds {} material points, the scene {}",
-                    resumed.len(),
-                    points.len()
-                )));
-            }
-            points = MaterialPoints {
-                body_force_path: points.body_force_path.take(),
-                ..resumed
-            };
+            resume_points(c, &mut points)?;
             solver.set_predictor_state(c.predictor.clone())?;
             (c.state, c.wall_time_s)
         }
         None => (RunState::start(&setup.stepping), 0.0),
     };
+    let dealt = control.ranks.as_ref().map(|r| deal(r, &mut points));
+    let own = dealt.transpose()?;
+    if let Some(r) = &control.ranks {
+        solver.on_ranks(Box::new(r.ranks.clone()));
+    }
     let mut reports = Vec::new();
     // The moving mesh after the last step, for `RunOutput::last`.
     let mut last_mesh = None;
@@ -369,10 +359,14 @@ where
                 );
             }
             if control.checkpoint {
+                let points = match (&control.ranks, &own) {
+                    (Some(r), Some(ids)) => whole_points(r, ids, pts, total)?,
+                    _ => pts.to_flat(),
+                };
                 snapshot.checkpoint = Some(Checkpoint {
                     state: now.state,
                     predictor: now.predictor.map(|(u, dl)| (u.to_vec(), dl)),
-                    points: pts.to_flat(),
+                    points,
                     wall_time_s: earlier_time + start.elapsed().as_secs_f64() - observer_time,
                     case_state: Vec::new(),
                 });
@@ -414,21 +408,75 @@ where
     })
 }
 
+/// Replaces the scene's `points` by the checkpoint's (the body-force path,
+/// code rather than state, kept).
+fn resume_points<const D: usize, H: Copy + Default + Flat, Dom: Copy + Flat>(
+    c: &Checkpoint,
+    points: &mut MaterialPoints<D, H, Dom>,
+) -> Result<(), SolverError> {
+    let resumed = MaterialPoints::from_flat(&c.points)?;
+    if resumed.len() != points.len() {
+        return Err(SolverError::InvalidInput(format!(
+            "the checkpoint holds {} material points, the scene {}",
+            resumed.len(),
+            points.len()
+        )));
+    }
+    *points = MaterialPoints {
+        body_force_path: points.body_force_path.take(),
+        ..resumed
+    };
+    Ok(())
+}
+
 /// Keeps this rank's points of `points` (all of the problem's, built on
-/// every rank) and returns their indices in the problem. A distributed run
-/// writes no checkpoint and resumes from none yet.
+/// every rank) and returns their indices in the problem.
 fn deal<const D: usize, H: Copy + Default, Dom: Copy>(
     run: &RankRun,
-    control: &RunControl,
     points: &mut MaterialPoints<D, H, Dom>,
 ) -> Result<Vec<usize>, SolverError> {
-    if control.checkpoint || control.resume.is_some() {
-        return Err(SolverError::InvalidInput(
-            "a run on several ranks writes no checkpoint and resumes from none (not yet: issue 42)"
-                .into(),
-        ));
-    }
     let ids = run.own_points(points.len())?;
     points.keep(&ids)?;
     Ok(ids)
+}
+
+/// The whole problem's points as numbers ([`MaterialPoints::to_flat`]) on
+/// rank 0, for its checkpoint: every rank's part (its points `ids` of
+/// `total`) sent there and joined ([`MaterialPoints::join`]); empty on the
+/// other ranks. The values travel as they are, so the checkpoint is the
+/// one a single process would hold at that state. Collective.
+///
+/// # Errors
+/// The transport's, or parts that do not join, on every rank.
+fn whole_points<const D: usize, H: Copy + Default + Flat, Dom: Copy + Flat>(
+    run: &RankRun,
+    ids: &[usize],
+    points: &MaterialPoints<D, H, Dom>,
+    total: usize,
+) -> Result<Vec<f64>, SolverError> {
+    let ranks = run.ranks.as_ref();
+    let mut message = Vec::with_capacity(1 + ids.len());
+    message.push(ids.len() as f64);
+    message.extend(ids.iter().map(|&p| p as f64));
+    message.extend(points.to_flat());
+    if !run.is_root() {
+        ranks.exchange(&[0], &[message], &mut [Vec::new()])?;
+        return ranks::agree(ranks, Ok(Vec::new()));
+    }
+    let others: Vec<usize> = (1..ranks.size()).collect();
+    let mut incoming = vec![Vec::new(); others.len()];
+    ranks.exchange(&others, &vec![Vec::new(); others.len()], &mut incoming)?;
+    let joined = (|| {
+        let mut ids_of = Vec::new();
+        let mut parts = Vec::new();
+        for m in std::iter::once(&message).chain(&incoming) {
+            let n = m.first().copied().unwrap_or(0.0) as usize;
+            let (head, flat) = m.split_at((1 + n).min(m.len()));
+            ids_of.push(head.iter().skip(1).map(|&i| i as usize).collect::<Vec<_>>());
+            parts.push(MaterialPoints::<D, H, Dom>::from_flat(flat)?);
+        }
+        let parts: Vec<(&[usize], _)> = ids_of.iter().map(Vec::as_slice).zip(parts).collect();
+        Ok(MaterialPoints::join(&parts, total)?.to_flat())
+    })();
+    ranks::agree(ranks, joined)
 }

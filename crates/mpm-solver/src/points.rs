@@ -153,6 +153,87 @@ impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
     }
 }
 
+impl<const D: usize, H: Copy + Default, Dom: Copy> MaterialPoints<D, H, Dom> {
+    /// The whole set from its ranks' parts, the inverse of [`Self::keep`]:
+    /// each part with the problem's indices of its points (`total` in
+    /// all); point loads renumbered back. The body-force path is code, not
+    /// state: the caller sets it again.
+    ///
+    /// # Errors
+    /// [`SolverError::InvalidInput`] when the parts do not hold every
+    /// point once, or hold an array some parts have and others do not.
+    pub fn join(parts: &[(&[usize], Self)], total: usize) -> Result<Self, SolverError> {
+        fn join_one<X: Clone, P>(
+            parts: &[(&[usize], P)],
+            total: usize,
+            array: impl Fn(&P) -> &Vec<X>,
+        ) -> Result<Vec<X>, SolverError> {
+            if parts.iter().all(|(_, p)| array(p).is_empty()) {
+                return Ok(Vec::new());
+            }
+            let mut whole: Vec<Option<X>> = vec![None; total];
+            for (ids, part) in parts {
+                let values = array(part);
+                if values.len() != ids.len() {
+                    return Err(SolverError::InvalidInput(format!(
+                        "joining points: a part of {} points holds {} values",
+                        ids.len(),
+                        values.len()
+                    )));
+                }
+                for (&id, v) in ids.iter().zip(values) {
+                    match whole.get_mut(id) {
+                        Some(slot @ None) => *slot = Some(v.clone()),
+                        _ => {
+                            return Err(SolverError::InvalidInput(format!(
+                                "joining points: point {id} twice or beyond {total}"
+                            )));
+                        }
+                    }
+                }
+            }
+            whole
+                .into_iter()
+                .enumerate()
+                .map(|(id, v)| {
+                    v.ok_or_else(|| {
+                        SolverError::InvalidInput(format!("joining points: point {id} in no part"))
+                    })
+                })
+                .collect()
+        }
+        let mut point_force = Vec::new();
+        for (ids, part) in parts {
+            for &(k, f) in &part.point_force {
+                let id = ids.get(k).copied().ok_or_else(|| {
+                    SolverError::InvalidInput(format!(
+                        "joining points: a load on point {k} of a part of {}",
+                        ids.len()
+                    ))
+                })?;
+                point_force.push((id, f));
+            }
+        }
+        point_force.sort_by_key(|&(id, _)| id);
+        Ok(Self {
+            position: join_one(parts, total, |p| &p.position)?,
+            displacement: join_one(parts, total, |p| &p.displacement)?,
+            mass: join_one(parts, total, |p| &p.mass)?,
+            volume0: join_one(parts, total, |p| &p.volume0)?,
+            volume: join_one(parts, total, |p| &p.volume)?,
+            f: join_one(parts, total, |p| &p.f)?,
+            be: join_one(parts, total, |p| &p.be)?,
+            history: join_one(parts, total, |p| &p.history)?,
+            sigma: join_one(parts, total, |p| &p.sigma)?,
+            domain0: join_one(parts, total, |p| &p.domain0)?,
+            domain: join_one(parts, total, |p| &p.domain)?,
+            body_force: join_one(parts, total, |p| &p.body_force)?,
+            point_force,
+            body_force_path: None,
+        })
+    }
+}
+
 /// Checks that the indices `ids` of points to keep ascend below `n`.
 pub(crate) fn check_kept(ids: &[usize], n: usize) -> Result<(), SolverError> {
     let ascending = ids.windows(2).all(|w| w[0] < w[1]);
@@ -189,4 +270,48 @@ pub(crate) fn check_points<const D: usize>(
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector2;
+
+    use super::MaterialPoints;
+
+    type Points = MaterialPoints<2, (), ()>;
+
+    fn five() -> Points {
+        let x = (0..5).map(|i| Vector2::new(f64::from(i), 1.0)).collect();
+        let mut p =
+            Points::new(x, vec![1.0, 2.0, 3.0, 4.0, 5.0], 2.0, vec![(); 5]).expect("points");
+        p.point_force = vec![(1, Vector2::new(1.0, 0.0)), (4, Vector2::new(4.0, 0.0))];
+        p
+    }
+
+    #[test]
+    fn the_parts_kept_join_into_the_whole_set() {
+        let whole = five();
+        let deal: [&[usize]; 2] = [&[0, 2, 4], &[1, 3]];
+        let parts: Vec<(&[usize], Points)> = deal
+            .iter()
+            .map(|&ids| {
+                let mut part = whole.clone();
+                part.keep(ids).expect("kept");
+                (ids, part)
+            })
+            .collect();
+        let joined = Points::join(&parts, 5).expect("joined");
+        assert_eq!(joined.position, whole.position);
+        assert_eq!(joined.volume, whole.volume);
+        assert_eq!(joined.mass, whole.mass);
+        assert_eq!(joined.point_force, whole.point_force);
+        assert!(joined.body_force.is_empty());
+        let missing = Points::join(&parts[..1], 5).expect_err("point 1 in no part");
+        assert!(
+            missing.to_string().contains("point 1 in no part"),
+            "{missing}"
+        );
+        let twice = Points::join(&[parts[0].clone(), parts[0].clone()], 5);
+        assert!(twice.is_err(), "a point held twice");
+    }
 }

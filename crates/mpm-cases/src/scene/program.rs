@@ -99,8 +99,10 @@ where
 /// here and write nothing.
 ///
 /// # Errors
-/// What a run on several ranks does not do yet (checkpoints), the
-/// deal's, and the run's on the other ranks.
+/// What a run on several ranks does not do yet (an explicit run's
+/// checkpoints), the deal's, and the run's on the other ranks: they
+/// resume from the checkpoint rank 0 wrote, and end without error when
+/// rank 0 stops the run after `--stop-after` steps.
 fn on_ranks<const D: usize>(
     problem: &crate::scene::Problem<D>,
     session: &Session,
@@ -109,25 +111,42 @@ fn on_ranks<const D: usize>(
 where
     crate::scene::Problem<D>: crate::scene::RunScene<D> + crate::scene::RunExplicit<D>,
 {
-    if session.resume || session.stop_after.is_some() {
+    let explicit = problem.explicit.is_some();
+    if explicit && (session.resume || session.stop_after.is_some()) {
         return Err(CasesError::from(mpm_solver::SolverError::InvalidInput(
-            "--resume and --stop-after (checkpoints) on several ranks: not yet (issue 42); run it on one process".into(),
+            "--resume and --stop-after (checkpoints) of an explicit scene on several ranks: not yet (issue 42); run it on one process".into(),
         )));
     }
     let run = super::ranks::rank_run(problem, shared.0.clone())?;
     if run.is_root() {
         return Ok(Some(run));
     }
+    let resume = if session.resume {
+        Some(crate::checkpoint::read(&session.out)?.1)
+    } else {
+        None
+    };
     let control = RunControl {
         ranks: Some(run),
+        // Rank 0 keeps checkpoints of an implicit run; the points are
+        // joined for them on every step, by every rank.
+        checkpoint: !explicit,
+        resume,
         ..RunControl::default()
     };
-    if problem.explicit.is_some() {
-        crate::scene::run_explicit(problem, &control, |_| Ok(()))?;
+    let result = if explicit {
+        crate::scene::run_explicit(problem, &control, |_| Ok(())).map(|_| ())
     } else {
-        crate::scene::run(problem, &control, |_, _, _| Ok(()))?;
+        crate::scene::run(problem, &control, |_, _, _| Ok(())).map(|_| ())
+    };
+    match result {
+        Err(mpm_solver::SolverError::Rank { rank: 0, message })
+            if session.stop_after.is_some() && message.starts_with("stopped after load step") =>
+        {
+            Ok(None)
+        }
+        other => other.map(|()| None).map_err(CasesError::from),
     }
-    Ok(None)
 }
 
 /// Runs a built scene, writing its results on the mesh `mesh`; on rank 0
@@ -146,11 +165,7 @@ where
     use crate::writer::VtuOptions;
 
     let (mut obs, mut control) = session.start(scene, mesh)?;
-    if ranks.is_some() {
-        // Checkpoints of a distributed run are not written yet.
-        control.checkpoint = false;
-        control.ranks = ranks;
-    }
+    control.ranks = ranks;
     obs.writer.set_vtu_options(VtuOptions {
         every: problem.every,
         fields: problem.fields.clone(),
