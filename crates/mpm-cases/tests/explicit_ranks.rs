@@ -55,18 +55,21 @@ fn run_with(problem: &Problem<2>, control: &RunControl) -> Seen {
 }
 
 fn on_ranks(problem: &Problem<2>, size: usize) -> Seen {
+    on_ranks_with(problem, size, &RunControl::default())
+}
+
+/// As [`on_ranks`], the run driven by `control` (checkpoints, resumption).
+fn on_ranks_with(problem: &Problem<2>, size: usize, control: &RunControl) -> Seen {
     let mut all = ThreadRanks::run(size, |ranks| {
         let mut run = mpm_cases::scene::ranks::rank_run(problem, Arc::new(ranks)).unwrap();
         // A stricter balance than the program's, so that the deal changes
         // within the run as the column spreads.
         run.balance.as_mut().unwrap().threshold = 1.02;
-        run_with(
-            problem,
-            &RunControl {
-                ranks: Some(run),
-                ..RunControl::default()
-            },
-        )
+        let control = RunControl {
+            ranks: Some(run),
+            ..control.clone()
+        };
+        run_with(problem, &control)
     });
     for other in &all[1..] {
         assert!(other.snapshots.is_empty(), "only rank 0 observes");
@@ -94,6 +97,83 @@ fn energy_difference(a: &[Energies], b: &[Energies]) -> f64 {
         (0..4).map(move |k| (x[k] - y[k]).abs())
     });
     d.fold(0.0f64, f64::max) / scale
+}
+
+/// The largest differences of positions (m) and stresses (of the largest)
+/// over the outputs of `a` and `b`.
+fn differences(a: &[Snapshot], b: &[Snapshot]) -> (f64, f64) {
+    let (mut dx, mut ds, mut s_max) = (0.0f64, 0.0f64, 0.0f64);
+    for (a, b) in a.iter().zip(b) {
+        assert_eq!(a.position.len(), b.position.len(), "every point once");
+        dx = dx.max(difference(&a.position, &b.position).0);
+        let (d, m) = difference(&a.sigma, &b.sigma);
+        (ds, s_max) = (ds.max(d), s_max.max(m));
+    }
+    (dx, ds / s_max)
+}
+
+/// A checkpoint at the fifth of ten outputs of a run on 4 ranks (after
+/// new deals) resumes on 4 ranks bit for bit: the ranks take back their
+/// points in the order they held them, under the deal of the moment. On 2
+/// ranks and on one process, and a one-process checkpoint on 4 ranks,
+/// within issue 42's bounds.
+#[test]
+fn a_checkpoint_of_the_column_on_ranks_resumes_on_any_number_of_ranks() {
+    let problem = problem();
+    let keep = RunControl {
+        checkpoint: true,
+        ..RunControl::default()
+    };
+    let whole = on_ranks_with(&problem, 4, &keep);
+    assert!(
+        !whole.rebalances.is_empty(),
+        "dealt anew before the checkpoint"
+    );
+    let at = 5;
+    let resume = RunControl {
+        resume: whole.snapshots[at].checkpoint.clone(),
+        ..RunControl::default()
+    };
+    let rest = &whole.snapshots[at + 1..];
+    let again = on_ranks_with(&problem, 4, &resume);
+    assert_eq!(again.steps, whole.steps);
+    assert_eq!(
+        again.snapshots.len(),
+        rest.len(),
+        "the outputs after the fifth"
+    );
+    assert_eq!(
+        again.energies,
+        whole.energies[at + 1..],
+        "4 ranks, bit for bit"
+    );
+    for (a, b) in rest.iter().zip(&again.snapshots) {
+        assert_eq!(a.position, b.position, "4 ranks, bit for bit");
+        assert_eq!(a.sigma, b.sigma, "4 ranks, bit for bit");
+    }
+    let single = run_with(&problem, &keep);
+    let from_single = RunControl {
+        resume: single.snapshots[at].checkpoint.clone(),
+        ..RunControl::default()
+    };
+    let others = [
+        ("4 ranks' on 2 ranks", on_ranks_with(&problem, 2, &resume)),
+        ("4 ranks' on 1 process", run_with(&problem, &resume)),
+        (
+            "1 process's on 4 ranks",
+            on_ranks_with(&problem, 4, &from_single),
+        ),
+    ];
+    for (name, other) in &others {
+        assert_eq!(other.steps, whole.steps, "{name}");
+        let (dx, ds) = differences(rest, &other.snapshots);
+        let de = energy_difference(&whole.energies[at + 1..], &other.energies);
+        eprintln!(
+            "checkpoint {name}: |dx| {:.1e} h, |dσ| {ds:.1e}, energies {de:.1e}",
+            dx / H
+        );
+        assert!(dx <= 1e-10 * H && ds <= 1e-9 && de <= 1e-10, "{name}");
+    }
 }
 
 #[test]
@@ -144,5 +224,27 @@ fn the_collapsing_column_on_ranks_equals_one_process() {
         for b in &ranks.rebalances {
             assert!(b.after < b.before && b.moved > 0, "{b:?}");
         }
+    }
+}
+
+/// Point loads name points by index, which migration changes: refused on
+/// several ranks, on every rank with the same message.
+#[test]
+fn an_explicit_point_load_on_ranks_is_refused_on_every_rank() {
+    let text =
+        format!("{COLLAPSE}\n[[load]]\nkind = \"point\"\nat = [0.5, 0.9]\nforce = [0.0, -1.0]\n");
+    let (scene, source) = scene::parse(&text, "point_load.toml", &[]).unwrap();
+    let problem = Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap();
+    let results = ThreadRanks::run(2, |ranks| {
+        let run = mpm_cases::scene::ranks::rank_run(&problem, Arc::new(ranks)).unwrap();
+        let control = RunControl {
+            ranks: Some(run),
+            ..RunControl::default()
+        };
+        scene::run_explicit(&problem, &control, |_| Ok(())).map(|_| ())
+    });
+    for r in results {
+        let e = r.unwrap_err().to_string();
+        assert!(e.contains("point loads and point fixities"), "{e}");
     }
 }

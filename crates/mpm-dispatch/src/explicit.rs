@@ -228,7 +228,7 @@ fn dispatch<const D: usize>(
 ) -> Result<ExplicitOutput, SolverError> {
     let (_, setup) = parts(problem)?;
     if control.ranks.is_some() {
-        explicit_ranks::supported(setup, control)?;
+        explicit_ranks::supported(setup)?;
     }
     let run = Run {
         problem,
@@ -380,7 +380,11 @@ impl<const D: usize> Run<'_, '_, D> {
             .map(|run| Spread::new(run, grid, reach))
             .transpose()?;
         if let Some(spread) = &spread {
-            points.keep(&spread.own_points(points.len())?)?;
+            // A resumed run restores every point, then deals them as the
+            // checkpoint says ([`Spread::resume`]).
+            if self.control.resume.is_none() {
+                points.keep(&spread.own_points(points.len())?)?;
+            }
             solver = solver.on_ranks(spread.ranks(), spread.initial_layout()?)?;
         }
         let mut bound = Bound { solver, points };
@@ -429,6 +433,14 @@ pub(crate) trait Stepper<const D: usize> {
     fn cell_loads(&self) -> Result<Vec<f64>, SolverError>;
     /// The cells dealt anew ([`ExplicitSolver::rebalance`]).
     fn rebalance(&mut self, layout: Decomposition) -> Result<(usize, usize), SolverError>;
+    /// Keeps the points at `order` (distinct indices), in that order.
+    fn keep(&mut self, order: &[usize]) -> Result<(), SolverError>;
+    /// The cell of every point held here (`None` off the grid).
+    fn cells(&self) -> Vec<Option<usize>>;
+    /// The work of the point forces on this rank's points so far.
+    fn local_work(&self) -> f64;
+    /// Sets it (a resumed run on several ranks).
+    fn set_local_work(&mut self, work: f64);
 }
 
 /// A typed solver with its points: the [`Stepper`] of one solver type.
@@ -460,11 +472,14 @@ where
     }
 
     fn reached(&self) -> Result<Reached, SolverError> {
+        // The energies' work is summed over the ranks (on one, the
+        // solver's).
+        let energies = self.solver.energies(&self.points)?;
         Ok(Reached {
             time: self.solver.time(),
             steps: self.solver.steps(),
-            energies: self.solver.energies(&self.points)?,
-            external_work: self.solver.external_work(),
+            energies,
+            external_work: energies.external_work,
         })
     }
 
@@ -527,6 +542,26 @@ where
     fn rebalance(&mut self, layout: Decomposition) -> Result<(usize, usize), SolverError> {
         self.solver.rebalance(&mut self.points, layout)
     }
+
+    fn keep(&mut self, order: &[usize]) -> Result<(), SolverError> {
+        self.points.keep(order)
+    }
+
+    fn cells(&self) -> Vec<Option<usize>> {
+        let grid = self.solver.mesh();
+        (self.points.position.iter())
+            .map(|x| grid.cell_id(grid.cell_containing(x).ok()?).ok())
+            .collect()
+    }
+
+    fn local_work(&self) -> f64 {
+        self.solver.external_work()
+    }
+
+    fn set_local_work(&mut self, work: f64) {
+        let (time, steps) = (self.solver.time(), self.solver.steps());
+        self.solver.resume_at(time, steps, work);
+    }
 }
 
 /// The scene's time loop, once per dimension: the start (or the resumed
@@ -550,6 +585,9 @@ fn time_loop<const D: usize>(
         Some(c) => {
             let clock = Clock::from_checkpoint(c)?;
             run.resume(c, &clock)?;
+            if let Some(spread) = &mut out.spread {
+                spread.resume(run, &c.case_state[Clock::LEN..], clock.external_work)?;
+            }
             wall.earlier = c.wall_time_s;
             clock
         }
@@ -734,7 +772,8 @@ impl<const D: usize> Outputs<'_, '_, D> {
             }))
         };
         wall.observe(|| {
-            let snapshot = snapshot(run, initial, at.time, control, at.steps, clock, so_far);
+            let spread = self.spread.as_ref();
+            let snapshot = snapshot(run, initial, at, control, clock, so_far, spread)?;
             match &self.spread {
                 Some(spread) => spread.observe_gathered(run.ids(), &snapshot, initial.len(), show),
                 None => show(&snapshot),
@@ -853,7 +892,7 @@ pub(crate) struct Clock {
 }
 
 impl Clock {
-    const LEN: usize = 7;
+    pub(crate) const LEN: usize = 7;
 
     fn to_case_state(self) -> Vec<f64> {
         let e = self.initial;
@@ -869,8 +908,9 @@ impl Clock {
     }
 
     fn from_checkpoint(c: &Checkpoint) -> Result<Self, SolverError> {
+        // A run on several ranks adds how they held the points.
         let s = &c.case_state;
-        if s.len() != Self::LEN || !(s[0] >= 0.0 && s[0].fract() == 0.0) {
+        if s.len() < Self::LEN || !(s[0] >= 0.0 && s[0].fract() == 0.0) {
             return Err(SolverError::InvalidInput(
                 "the checkpoint was not written by an explicit run of this scene".into(),
             ));
@@ -889,19 +929,30 @@ impl Clock {
     }
 }
 
-/// A snapshot of the points after `steps` steps, with a checkpoint when
-/// the run keeps them.
+/// A snapshot of the points at `at`, with a checkpoint when the run keeps
+/// them: on several ranks (`spread`) rank 0's holds every point, in the
+/// order of their ids, and how the ranks held them. Collective then.
+///
+/// # Errors
+/// The gather's, on every rank.
 fn snapshot<const D: usize>(
     run: &dyn Stepper<D>,
     initial: &[SVector<f64, D>],
-    time: f64,
+    at: &Reached,
     control: &RunControl,
-    steps: usize,
     clock: &Clock,
     wall_time_s: f64,
-) -> Snapshot {
+    spread: Option<&Spread<'_>>,
+) -> Result<Snapshot, SolverError> {
+    let (time, steps) = (at.time, at.steps);
     let mut snap = run.snapshot(initial, time);
     if control.checkpoint {
+        let (points, held) = match spread {
+            Some(spread) => spread.checkpoint(run, initial.len())?,
+            None => (run.flat_points(), Vec::new()),
+        };
+        let mut case_state = clock.to_case_state();
+        case_state.extend(held);
         snap.checkpoint = Some(Checkpoint {
             state: RunState {
                 load_factor: time,
@@ -913,12 +964,12 @@ fn snapshot<const D: usize>(
                 },
             },
             predictor: None,
-            points: run.flat_points(),
+            points,
             wall_time_s,
-            case_state: clock.to_case_state(),
+            case_state,
         });
     }
-    snap
+    Ok(snap)
 }
 
 /// The points as plain arrays: positions, displacements from `initial`,

@@ -7,9 +7,16 @@
 //! observes: the points are gathered onto it, by global id, at every
 //! output; what it decides (an output error, a stop) is agreed.
 //!
-//! Not yet on several ranks (refused): checkpoints and resumption, point
-//! forces and point fixities (they name points by index, which migration
-//! changes), the cell-averaged dilatation.
+//! A checkpoint holds every point in the order of its id (the file one
+//! process writes) and how the ranks held them: the deal of the cells,
+//! each point's rank and place there, each rank's work of the point
+//! forces. Resumed on as many ranks, each takes its points back in the
+//! same order, so the run goes on bit for bit; on another number (or from
+//! a one-process checkpoint), the cells are dealt from the points' cells.
+//!
+//! Not yet on several ranks (refused): point forces and point fixities
+//! (they name points by index, which migration changes), the
+//! cell-averaged dilatation.
 
 use std::sync::Arc;
 
@@ -20,7 +27,7 @@ use mpm_solver::ranks::{self, Decomposition, Ranks, Reduce};
 
 use crate::explicit::Stepper;
 use crate::on_ranks::{RankRun, gather, imbalance, keep_names};
-use crate::run::{RunControl, Snapshot};
+use crate::run::Snapshot;
 
 /// A new deal of the cells during a run on several ranks.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,23 +46,58 @@ pub struct Rebalanced {
 ///
 /// # Errors
 /// [`SolverError::InvalidInput`] naming it.
-pub(crate) fn supported<const D: usize>(
-    setup: &ExplicitSetup<D>,
-    control: &RunControl,
-) -> Result<(), SolverError> {
-    let refuse = |what: &str| {
-        Err(SolverError::InvalidInput(format!(
-            "{what} of an explicit scene on several ranks: not yet (issue 42); run it on one process"
-        )))
-    };
-    if control.checkpoint || control.resume.is_some() {
-        return refuse("checkpoints and resumption");
-    }
+pub(crate) fn supported<const D: usize>(setup: &ExplicitSetup<D>) -> Result<(), SolverError> {
     let point_loads = !setup.point_forces.is_empty() || !setup.timed_forces.is_empty();
     if point_loads || !setup.point_fixities.is_empty() {
-        return refuse("point loads and point fixities");
+        return Err(SolverError::InvalidInput(
+            "point loads and point fixities of an explicit scene on several ranks: not yet (issue 42); run it on one process".into(),
+        ));
     }
     Ok(())
+}
+
+/// From a checkpoint's `held` of `size` ranks (as [`Spread::join`] wrote
+/// it), rank `me`'s deal of the `cells`, its points of the `total` in
+/// their order, and its work of the point forces.
+///
+/// # Errors
+/// A `held` of another length, or ranks and places out of range.
+fn held_by(
+    held: &[f64],
+    size: usize,
+    cells: usize,
+    total: usize,
+    me: usize,
+) -> Result<(Vec<usize>, Vec<usize>, f64), SolverError> {
+    let bad = || {
+        SolverError::InvalidInput(
+            "the checkpoint's record of the ranks does not fit this scene".into(),
+        )
+    };
+    if held.len() != 1 + size + cells + 2 * total {
+        return Err(bad());
+    }
+    let index = |x: f64, below: usize| {
+        (x >= 0.0 && x.fract() == 0.0 && (x as usize) < below)
+            .then_some(x as usize)
+            .ok_or_else(bad)
+    };
+    let deal = (held[1 + size..1 + size + cells].iter())
+        .map(|&r| index(r, size))
+        .collect::<Result<Vec<_>, _>>()?;
+    let places = &held[1 + size + cells..];
+    let mut mine = Vec::new();
+    for id in 0..total {
+        if index(places[2 * id], size)? == me {
+            mine.push((index(places[2 * id + 1], total)?, id));
+        }
+    }
+    mine.sort_unstable();
+    Ok((
+        deal,
+        mine.into_iter().map(|(_, id)| id).collect(),
+        held[1 + me],
+    ))
 }
 
 /// A run's spread over the ranks: the deal, the grid's connectivity for
@@ -175,6 +217,125 @@ impl<'a> Spread<'a> {
             after,
             moved: moved[0] as usize,
         }))
+    }
+
+    /// A checkpoint's points on rank 0 — every rank's records
+    /// ([`Stepper::flat_points`]) placed by id, the count first: what one
+    /// process writes — and how the ranks held them ([`Self::resume`]);
+    /// empty on the other ranks. Collective.
+    ///
+    /// # Errors
+    /// The transport's, or parts that do not cover the points once, on
+    /// every rank.
+    pub(crate) fn checkpoint<const D: usize>(
+        &self,
+        run: &dyn Stepper<D>,
+        total: usize,
+    ) -> Result<(Vec<f64>, Vec<f64>), SolverError> {
+        let ranks = self.run.ranks.as_ref();
+        let ids = run.ids();
+        let flat = run.flat_points();
+        let mut message = Vec::with_capacity(1 + ids.len() + flat.len());
+        message.push(ids.len() as f64);
+        message.extend(ids.iter().map(|&p| p as f64));
+        message.push(run.local_work());
+        message.extend(flat.iter().skip(1));
+        if !self.run.is_root() {
+            ranks.exchange(&[0], &[message], &mut [Vec::new()])?;
+            return ranks::agree(ranks, Ok((Vec::new(), Vec::new())));
+        }
+        let others: Vec<usize> = (1..ranks.size()).collect();
+        let mut incoming = vec![Vec::new(); others.len()];
+        ranks.exchange(&others, &vec![Vec::new(); others.len()], &mut incoming)?;
+        let parts: Vec<&Vec<f64>> = std::iter::once(&message).chain(&incoming).collect();
+        ranks::agree(ranks, self.join(&parts, total))
+    }
+
+    /// Rank 0's side of [`Self::checkpoint`]: the parts (rank by rank:
+    /// count, ids, work, records) joined.
+    fn join(&self, parts: &[&Vec<f64>], total: usize) -> Result<(Vec<f64>, Vec<f64>), SolverError> {
+        let bad =
+            |what: &str| SolverError::InvalidInput(format!("a checkpoint of the ranks: {what}"));
+        let (size, cells) = (parts.len(), self.rank_of_cell.len());
+        let numbers = parts.iter().map(|m| m.len()).sum::<usize>();
+        let per = (numbers.saturating_sub(2 * size + total)) / total.max(1);
+        let mut whole = vec![0.0; 1 + total * per];
+        whole[0] = total as f64;
+        let mut held = vec![0.0; 1 + size + cells + 2 * total];
+        held[0] = size as f64;
+        for (c, &r) in self.rank_of_cell.iter().enumerate() {
+            held[1 + size + c] = r as f64;
+        }
+        let place = 1 + size + cells;
+        let mut seen = vec![false; total];
+        for (rank, m) in parts.iter().enumerate() {
+            let n = m.first().copied().unwrap_or(0.0) as usize;
+            if m.len() != 2 + n * (1 + per) {
+                return Err(bad("a part of another length than its points"));
+            }
+            held[1 + rank] = m[1 + n];
+            let records = m[2 + n..].chunks_exact(per.max(1));
+            for (slot, (&id, record)) in m[1..1 + n].iter().zip(records).enumerate() {
+                let id = id as usize;
+                match seen.get_mut(id) {
+                    Some(s) if !*s => *s = true,
+                    _ => return Err(bad("a point twice or beyond the problem")),
+                }
+                whole[1 + id * per..1 + (id + 1) * per].copy_from_slice(record);
+                held[place + 2 * id] = rank as f64;
+                held[place + 2 * id + 1] = slot as f64;
+            }
+        }
+        if seen.iter().any(|s| !s) {
+            return Err(bad("a point of no rank"));
+        }
+        Ok((whole, held))
+    }
+
+    /// After the points were restored whole on every rank: each rank keeps
+    /// its own as `held` says (a checkpoint of as many ranks: the same deal
+    /// and order, so the run goes on bit for bit) or, from a checkpoint of
+    /// another number of ranks or of one process, those of its cells in a
+    /// new deal, rank 0 taking the work of the point forces (`work`, the
+    /// sum over the ranks). Collective.
+    ///
+    /// # Errors
+    /// A `held` that does not fit, the repartition's, the transport's.
+    pub(crate) fn resume<const D: usize>(
+        &mut self,
+        run: &mut dyn Stepper<D>,
+        held: &[f64],
+        work: f64,
+    ) -> Result<(), SolverError> {
+        let (size, me) = (self.run.ranks.size(), self.run.ranks.rank());
+        let (total, cells) = (run.ids().len(), self.rank_of_cell.len());
+        let same_ranks = held.first() == Some(&(size as f64));
+        let (deal, order, work) = if same_ranks {
+            held_by(held, size, cells, total, me)?
+        } else {
+            let balance = self.run.balance.as_ref().ok_or_else(|| {
+                SolverError::InvalidInput(
+                    "resuming on another number of ranks needs a new deal (RankRun::balance)"
+                        .into(),
+                )
+            })?;
+            let of_points = run.cells();
+            let mut loads = vec![0.0; cells];
+            for &c in of_points.iter().flatten() {
+                loads[c] += 1.0;
+            }
+            let deal = ranks::agree(self.run.ranks.as_ref(), (balance.repartition)(&loads))?;
+            let mine = |p: &usize| of_points[*p].map_or(me == 0, |c| deal.get(c) == Some(&me));
+            let order = (0..total).filter(mine).collect();
+            (deal, order, if me == 0 { work } else { 0.0 })
+        };
+        run.keep(&order)?;
+        // Every point is in its rank's cells: nothing moves, the deal is
+        // installed.
+        run.rebalance(self.layout(deal.clone())?)?;
+        run.set_local_work(work);
+        self.rank_of_cell = deal;
+        Ok(())
     }
 
     /// Runs `observe` on rank 0 and agrees on its verdict. Collective.

@@ -99,10 +99,9 @@ where
 /// here and write nothing.
 ///
 /// # Errors
-/// What a run on several ranks does not do yet (an explicit run's
-/// checkpoints), the deal's, and the run's on the other ranks: they
-/// resume from the checkpoint rank 0 wrote, and end without error when
-/// rank 0 stops the run after `--stop-after` steps.
+/// The deal's, and the run's on the other ranks: they resume from the
+/// checkpoint rank 0 wrote, and end without error when rank 0 stops the
+/// run after `--stop-after` steps or outputs.
 fn on_ranks<const D: usize>(
     problem: &crate::scene::Problem<D>,
     session: &Session,
@@ -112,11 +111,6 @@ where
     crate::scene::Problem<D>: crate::scene::RunScene<D> + crate::scene::RunExplicit<D>,
 {
     let explicit = problem.explicit.is_some();
-    if explicit && (session.resume || session.stop_after.is_some()) {
-        return Err(CasesError::from(mpm_solver::SolverError::InvalidInput(
-            "--resume and --stop-after (checkpoints) of an explicit scene on several ranks: not yet (issue 42); run it on one process".into(),
-        )));
-    }
     let run = super::ranks::rank_run(problem, shared.0.clone())?;
     if run.is_root() {
         return Ok(Some(run));
@@ -128,9 +122,9 @@ where
     };
     let control = RunControl {
         ranks: Some(run),
-        // Rank 0 keeps checkpoints of an implicit run; the points are
-        // joined for them on every step, by every rank.
-        checkpoint: !explicit,
+        // Rank 0 keeps checkpoints; the points are joined for them at
+        // every step or output, by every rank.
+        checkpoint: true,
         resume,
         ..RunControl::default()
     };
@@ -353,11 +347,7 @@ where
     };
     let end_time = setup.end_time;
     let (mut obs, mut control) = session.start(scene, grid)?;
-    if ranks.is_some() {
-        // Checkpoints of a distributed run are not written yet.
-        control.checkpoint = false;
-        control.ranks = ranks;
-    }
+    control.ranks = ranks;
     let mut rebalances = Vec::new();
     obs.show_time();
     obs.writer.set_vtu_options(VtuOptions {

@@ -75,21 +75,31 @@ impl<const D: usize, S, T, Dom> ExplicitPoints<D, S, T, Dom> {
         self.tau[p] / self.f[p].determinant()
     }
 
-    /// Keeps the points at the indices `ids` (ascending), in that order,
+    /// Keeps the points at the indices `ids` (distinct), in that order,
     /// with their ids: a rank's part of a point set that every rank built
-    /// whole. Point forces and fixities are renumbered and those of other
-    /// points dropped.
+    /// whole, in the order it held them. Point forces and fixities are
+    /// renumbered and those of other points dropped.
     ///
     /// # Errors
-    /// [`SolverError::InvalidInput`] for indices that do not ascend or lie
-    /// beyond the set.
+    /// [`SolverError::InvalidInput`] for an index twice or beyond the set.
     pub fn keep(&mut self, ids: &[usize]) -> Result<(), SolverError>
     where
         S: Clone,
         T: Clone,
         Dom: Clone,
     {
-        crate::points::check_kept(ids, self.len())?;
+        let n = self.len();
+        let mut slot_of = vec![usize::MAX; n];
+        for (k, &i) in ids.iter().enumerate() {
+            match slot_of.get_mut(i) {
+                Some(slot) if *slot == usize::MAX => *slot = k,
+                _ => {
+                    return Err(SolverError::InvalidInput(format!(
+                        "the points to keep must be distinct and below {n}"
+                    )));
+                }
+            }
+        }
         fn pick<X: Clone>(v: &mut Vec<X>, ids: &[usize]) {
             *v = ids.iter().map(|&i| v[i].clone()).collect();
         }
@@ -105,7 +115,7 @@ impl<const D: usize, S, T, Dom> ExplicitPoints<D, S, T, Dom> {
         pick(&mut self.transfer, ids);
         pick(&mut self.domain, ids);
         pick(&mut self.domain0, ids);
-        let at = |p: usize| ids.binary_search(&p).ok();
+        let at = |p: usize| slot_of.get(p).copied().filter(|&k| k != usize::MAX);
         self.point_force = (self.point_force.iter())
             .filter_map(|&(p, f)| at(p).map(|k| (k, f)))
             .collect();
@@ -216,7 +226,10 @@ mod tests {
         assert_eq!(points.mass, [2.0, 2.0]);
         assert_eq!(points.point_force, [(0, Vector2::new(1.0, 0.0))]);
         assert_eq!(points.fixed_velocity, [(1, 1, 0.5)]);
-        assert!(points.keep(&[1, 0]).is_err(), "not ascending");
+        assert!(points.keep(&[1, 1]).is_err(), "twice");
         assert!(points.keep(&[2]).is_err(), "beyond the set");
+        points.keep(&[1, 0]).expect("any order");
+        assert_eq!(points.id, [3, 1]);
+        assert_eq!(points.fixed_velocity, [(0, 1, 0.5)]);
     }
 }
