@@ -306,6 +306,52 @@ fn a_job_killed_and_resumed_writes_the_uninterrupted_files() {
     std::fs::remove_dir_all(&root).ok();
 }
 
+/// The column thrown up at 30 m/s: its top points leave the grid within
+/// a few steps, on one process of two. The whole job ends at once, every
+/// process with the error that names the point (the failing rank its own,
+/// the other `Rank`), well within 5 s, and no process is left.
+#[test]
+fn a_point_leaving_the_grid_on_one_process_ends_the_whole_job() {
+    let root = std::env::temp_dir().join(format!("mpm-mpi-fail-{}", std::process::id()));
+    std::fs::create_dir_all(&root).unwrap();
+    let column = std::fs::read_to_string(scene_named("explicit_collapse.toml")).unwrap();
+    let region = "region = { box = { lower = [0.0, 0.0], upper = [1.0, 1.0] } }";
+    assert!(column.contains(region));
+    let thrown = column.replace(region, &format!("{region}\nvelocity = [0.0, 30.0]"));
+    let scene = root.join("thrown.toml");
+    std::fs::write(&scene, thrown).unwrap();
+    let out_dir = root.join("out");
+    let begun = Instant::now();
+    let job = start(
+        2,
+        &[scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap()],
+    );
+    let group = job.id();
+    let out = job.wait_with_output().unwrap();
+    let took = begun.elapsed();
+    let t = text(&out);
+    assert!(!out.status.success(), "{t}");
+    eprintln!("a point off the grid on 2 processes: the job ended after {took:?}");
+    assert!(took < Duration::from_secs(5), "{took:?}\n{t}");
+    assert!(
+        t.contains("rank 0 of 2") && t.contains("rank 1 of 2"),
+        "{t}"
+    );
+    assert!(
+        t.contains("material point"),
+        "the point named on every process:\n{t}"
+    );
+    let ended = Instant::now();
+    while group_alive(group) {
+        assert!(
+            ended.elapsed() < Duration::from_secs(5),
+            "processes are left"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::fs::remove_dir_all(&root).ok();
+}
+
 /// A built-in case (typed, not a scene) is refused on every process and
 /// the job ends.
 #[test]
