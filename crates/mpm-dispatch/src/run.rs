@@ -332,8 +332,9 @@ where
     };
     let dealt = control.ranks.as_ref().map(|r| deal(r, &mut points));
     let own = dealt.transpose()?;
-    if let Some(r) = &control.ranks {
+    if let (Some(r), Some(ids)) = (&control.ranks, &own) {
         solver.on_ranks(Box::new(r.ranks.clone()));
+        solver.name_points(ids.clone());
     }
     let mut reports = Vec::new();
     // The moving mesh after the last step, for `RunOutput::last`.

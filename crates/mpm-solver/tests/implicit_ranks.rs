@@ -97,6 +97,10 @@ fn ranks_reproduce_the_single_solver_with_fbar() {
 #[test]
 fn a_failure_on_one_rank_stops_every_rank_with_its_error() {
     let outcomes = on_threads(3, Treatment::Standard, Deal::Stray);
+    // Rank 1's first point strays; the failure names it by its index in
+    // the problem (the strip's lowest row: its column), as one process
+    // would, not by its index on rank 1 (0).
+    let mut named = None;
     for (rank, outcome) in outcomes.iter().enumerate() {
         let Err(SolverError::InStep {
             step: 0, source, ..
@@ -105,12 +109,19 @@ fn a_failure_on_one_rank_stops_every_rank_with_its_error() {
             panic!("rank {rank}: {outcome:?}");
         };
         match (rank, &**source) {
-            (1, SolverError::Basis { point: 0, .. }) => {}
-            (0 | 2, SolverError::Rank { rank: 1, message }) => {
-                assert!(message.contains("material point 0"), "{message}");
-            }
+            (1, SolverError::Basis { point, .. }) => named = Some(*point),
+            (0 | 2, SolverError::Rank { rank: 1, .. }) => {}
             _ => panic!("rank {rank}: {source:?}"),
         }
+    }
+    let point = named.unwrap();
+    assert!(point > 0, "the global id of rank 1's first point");
+    for outcome in &outcomes {
+        let message = outcome.as_ref().unwrap_err().to_string();
+        assert!(
+            message.contains(&format!("material point {point} ")),
+            "{message}"
+        );
     }
 }
 

@@ -201,6 +201,16 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         self.ranks = Some(on_ranks::RankLink::new(ranks));
     }
 
+    /// On several ranks, the problem's index of each of this rank's points
+    /// (e.g. their global ids), by which its failures name them, as one
+    /// process would; without it they name the rank's local indices.
+    /// Nothing on one rank.
+    pub fn name_points(&mut self, ids: Vec<usize>) {
+        if let Some(link) = &mut self.ranks {
+            link.name_points(ids);
+        }
+    }
+
     /// This rank and the number of ranks ((0, 1) on one).
     pub fn rank(&self) -> (usize, usize) {
         self.ranks

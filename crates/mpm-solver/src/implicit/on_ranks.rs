@@ -39,6 +39,9 @@ pub(super) struct RankLink {
     /// The first transport failure of a stage that cannot return it (the
     /// driver reads it before it uses the stage's result).
     failure: Option<SolverError>,
+    /// The problem's index of each of this rank's points, which failures
+    /// name; empty: the local indices.
+    ids: Vec<usize>,
 }
 
 impl std::fmt::Debug for RankLink {
@@ -88,7 +91,37 @@ impl RankLink {
         Self {
             ranks,
             failure: None,
+            ids: Vec::new(),
         }
+    }
+
+    /// Names this rank's points by `ids` (their indices in the problem) in
+    /// the failures it reports.
+    pub(super) fn name_points(&mut self, ids: Vec<usize>) {
+        self.ids = ids;
+    }
+
+    /// The problem's index of local point `p`.
+    fn global(&self, p: usize) -> usize {
+        self.ids.get(p).copied().unwrap_or(p)
+    }
+
+    /// `f` naming its point by the problem's index.
+    fn named_step(&self, mut f: StepFailure) -> StepFailure {
+        if let StepFailure::Constitutive { point, .. }
+        | StepFailure::ExcessiveIncrement { point, .. } = &mut f
+        {
+            *point = self.global(*point);
+        }
+        f
+    }
+
+    /// `e` naming its point by the problem's index.
+    fn named(&self, mut e: SolverError) -> SolverError {
+        if let SolverError::Basis { point, .. } | SolverError::DomainUpdate { point, .. } = &mut e {
+            *point = self.global(*point);
+        }
+        e
     }
 
     /// This rank and the number of ranks.
@@ -117,7 +150,7 @@ impl RankLink {
 
     /// A local outcome decided over the ranks ([`ranks::agree`]).
     pub(super) fn agree(&self, local: Result<(), SolverError>) -> Result<(), SolverError> {
-        ranks::agree(self.ranks.as_ref(), local)
+        ranks::agree(self.ranks.as_ref(), local.map_err(|e| self.named(e)))
     }
 
     /// A local failure of a Newton iterate decided over the ranks: when
@@ -125,6 +158,7 @@ impl RankLink {
     /// and every other rank [`StepFailure::OnRank`] with its message and
     /// whether it backtracks, so that all ranks take the same branch.
     pub(super) fn agree_step(&mut self, local: Result<(), StepFailure>) -> Result<(), StepFailure> {
+        let local = local.map_err(|f| self.named_step(f));
         // The first character says whether the failure backtracks.
         let describe = || match &local {
             Err(f) => format!("{}{f}", if backtracks(f) { 'b' } else { 'f' }),

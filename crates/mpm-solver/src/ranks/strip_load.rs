@@ -184,6 +184,7 @@ where
         );
     if let Some(r) = ranks {
         solver.on_ranks(r);
+        solver.name_points(ids.clone());
     }
     let (mut residuals, mut reactions) = (Vec::new(), Vec::new());
     solver.run(
