@@ -55,6 +55,7 @@ mod mpoint;
 mod petsc;
 mod plate;
 mod plot;
+mod ranks;
 mod reference_values;
 mod report;
 mod scene_run;
@@ -119,6 +120,12 @@ tasks:
                 the full vane with F-patch solved by our ILU(0)/BiCGSTAB and by PETSc's
                 GAMG, BoomerAMG and block Jacobi (xtask built with --features petsc);
                 writes docs/src/benchmarks/petsc.md. --full: the paper's mesh (slow)
+  ranks [--quick]
+                a scene on 2 MPI processes against 1 process with 1 and 2 threads
+                (mpirun -n 2 mpm run): the explicit column at 200,704 points and the
+                F-patch notched plate, solver time per stage, repeated and
+                interleaved; builds mpm with --features mpi, needs Open MPI; writes
+                docs/src/benchmarks/ranks_scenes.md (about 3 min; --quick: small)
   structure [--deny]
                 functions over 150 lines and import circles between files in every
                 crate's src/ (tests left out); --deny fails on any
@@ -146,6 +153,10 @@ fn main() -> Result<()> {
                 [other, ..] => bail!("unexpected argument `{other}` (expected --quick)"),
             };
             report::run(&docs_dir(), mode)
+        }
+        Some("ranks") => {
+            let quick = flag(&args[1..], "--quick")?;
+            ranks::run(quick, &workspace_dir(), &docs_dir())
         }
         Some("structure") => {
             let deny = flag(&args[1..], "--deny")?;
