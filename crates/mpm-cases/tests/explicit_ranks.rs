@@ -129,6 +129,15 @@ fn a_checkpoint_of_the_column_on_ranks_resumes_on_any_number_of_ranks() {
         !whole.rebalances.is_empty(),
         "dealt anew before the checkpoint"
     );
+    // Mass is conserved exactly: after 1,095 steps of migrations and the
+    // new deals, the last checkpoint (every point's record, its mass after
+    // position and velocity) holds each point's initial mass, bit for bit.
+    let last = whole.snapshots.last().unwrap().checkpoint.as_ref().unwrap();
+    let n = problem.mass.len();
+    assert_eq!(last.points[0], n as f64, "every point once");
+    let per = (last.points.len() - 1) / n;
+    let masses: Vec<f64> = last.points[1..].chunks_exact(per).map(|r| r[4]).collect();
+    assert_eq!(masses, problem.mass, "each point's mass");
     let at = 5;
     let resume = RunControl {
         resume: whole.snapshots[at].checkpoint.clone(),
