@@ -31,8 +31,12 @@ struct Seen {
     rebalances: Vec<Rebalanced>,
 }
 
+/// The column, its cells dealt anew past 2 % above the mean (a stricter
+/// balance than the scene's, so that the deal changes within the run as
+/// the column spreads).
 fn problem() -> Problem<2> {
-    let (scene, source) = scene::parse(COLLAPSE, "explicit_collapse.toml", &[]).unwrap();
+    let strict = ["solver.rebalance_threshold=1.02".to_owned()];
+    let (scene, source) = scene::parse(COLLAPSE, "explicit_collapse.toml", &strict).unwrap();
     Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap()
 }
 
@@ -61,10 +65,7 @@ fn on_ranks(problem: &Problem<2>, size: usize) -> Seen {
 /// As [`on_ranks`], the run driven by `control` (checkpoints, resumption).
 fn on_ranks_with(problem: &Problem<2>, size: usize, control: &RunControl) -> Seen {
     let mut all = ThreadRanks::run(size, |ranks| {
-        let mut run = mpm_cases::scene::ranks::rank_run(problem, Arc::new(ranks)).unwrap();
-        // A stricter balance than the program's, so that the deal changes
-        // within the run as the column spreads.
-        run.balance.as_mut().unwrap().threshold = 1.02;
+        let run = mpm_cases::scene::ranks::rank_run(problem, Arc::new(ranks)).unwrap();
         let control = RunControl {
             ranks: Some(run),
             ..control.clone()
@@ -256,4 +257,30 @@ fn an_explicit_point_load_on_ranks_is_refused_on_every_rank() {
         let e = r.unwrap_err().to_string();
         assert!(e.contains("point loads and point fixities"), "{e}");
     }
+}
+
+/// The balance keys are the explicit solver's, checked where they stand.
+#[test]
+fn the_balance_keys_are_checked_at_the_key() {
+    let refused = |text: &str, set: &str| {
+        let set = [set.to_owned()];
+        let e = match scene::parse(text, "keys.toml", &set) {
+            Ok((scene, source)) => Problem::<2>::build(&scene, &source, scene.solver.padding())
+                .err()
+                .map(|e| e.to_string()),
+            Err(e) => Some(e.to_string()),
+        };
+        e.unwrap_or_else(|| panic!("{set:?} accepted"))
+    };
+    let e = refused(COLLAPSE, "solver.rebalance_threshold=1.0");
+    assert!(
+        e.contains("rebalance_threshold") && e.contains("above 1"),
+        "{e}"
+    );
+    let implicit = include_str!("../../../scenes/strip_footing_ranks.toml");
+    let e = refused(implicit, "solver.rebalance_every=10");
+    assert!(
+        e.contains("rebalance_every") && e.contains("kind = \"explicit\""),
+        "{e}"
+    );
 }

@@ -966,6 +966,7 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/explicit_bar.toml"),
         include_str!("../../../scenes/explicit_disks.toml"),
         include_str!("../../../scenes/explicit_cube.toml"),
+        include_str!("../../../scenes/explicit_collapse.toml"),
     ]
     .join("\n");
     let mut keys = Vec::new();

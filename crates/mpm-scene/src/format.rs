@@ -587,6 +587,16 @@ pub struct SolverSpec {
     /// Explicit: simulated time between outputs (default `end_time`/20).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub output_interval: Option<Spanned<f64>>,
+    /// Explicit, on several processes: steps between two counts of the
+    /// points per process (default 50; 0: the cells are never dealt
+    /// anew).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rebalance_every: Option<Spanned<usize>>,
+    /// Explicit, on several processes: the imbalance (most loaded
+    /// process's points over the mean, above 1) past which the cells are
+    /// dealt anew (default 1.1).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rebalance_threshold: Option<Spanned<f64>>,
 }
 
 impl SolverSpec {
@@ -690,6 +700,8 @@ impl Default for SolverSpec {
             transfer: None,
             alpha: None,
             output_interval: None,
+            rebalance_every: None,
+            rebalance_threshold: None,
         }
     }
 }

@@ -19,14 +19,6 @@ use crate::scene::Problem;
 use crate::scene::build::SceneMesh;
 use crate::variant::LockingKind;
 
-/// Steps between two counts of an explicit run's points per rank.
-pub const BALANCE_EVERY: usize = 50;
-
-/// The imbalance (most loaded rank's points over the mean) past which an
-/// explicit run's cells are dealt anew: 10 %, a step's work being
-/// proportional to the points and the wait at the halo to the largest.
-pub const BALANCE_THRESHOLD: f64 = 1.1;
-
 /// The mesh as plain connectivity and the element of every point.
 struct Cells {
     nodes: usize,
@@ -83,7 +75,7 @@ impl Cells {
 
 /// The run of `problem` on `ranks`: the rank of every point and cell,
 /// and for an explicit run the new deals of its cells as its points move
-/// ([`BALANCE_EVERY`], [`BALANCE_THRESHOLD`]). An implicit run's deal is
+/// (its `rebalance_every` and `rebalance_threshold`). An implicit run's deal is
 /// METIS's over elements (whole patches under F-patch) weighed by their
 /// points and nodes (the assembly's work); an explicit run's is from the
 /// start the one its new deals make, weighed by the points.
@@ -97,8 +89,9 @@ pub fn rank_run<const D: usize>(
 ) -> Result<RankRun, CasesError> {
     let cells = Cells::of(problem)?;
     let element_of_point = cells.element_of_point.clone();
-    let (rank_of_cell, balance) = if problem.explicit.is_some() {
-        explicit_deal(cells, ranks.size())?
+    let (rank_of_cell, balance) = if let Some(setup) = &problem.explicit {
+        let (every, threshold) = (setup.rebalance_every, setup.rebalance_threshold);
+        explicit_deal(cells, ranks.size(), every, threshold)?
     } else {
         (implicit_deal(problem, &cells, ranks.size())?, None)
     };
@@ -125,7 +118,12 @@ fn implicit_deal<const D: usize>(
 }
 
 /// The first deal of an explicit run and its new deals.
-fn explicit_deal(cells: Cells, ranks: usize) -> Result<(Vec<usize>, Option<Balance>), SolverError> {
+fn explicit_deal(
+    cells: Cells,
+    ranks: usize,
+    every: usize,
+    threshold: f64,
+) -> Result<(Vec<usize>, Option<Balance>), SolverError> {
     let mut loads = vec![0.0; cells.connectivity.len() / cells.nodes_per_element];
     for &e in &cells.element_of_point {
         loads[e] += 1.0;
@@ -133,8 +131,8 @@ fn explicit_deal(cells: Cells, ranks: usize) -> Result<(Vec<usize>, Option<Balan
     let deal = repartition(cells, ranks);
     let rank_of_cell = deal(&loads)?;
     let balance = Balance {
-        every: BALANCE_EVERY,
-        threshold: BALANCE_THRESHOLD,
+        every,
+        threshold,
         repartition: deal,
     };
     Ok((rank_of_cell, Some(balance)))

@@ -25,6 +25,10 @@ pub(super) struct ExplicitKeys {
     pub(super) alpha: f64,
     /// `locking`.
     pub(super) locking: LockingKind,
+    /// `rebalance_every` (steps; 0: never).
+    pub(super) rebalance_every: usize,
+    /// `rebalance_threshold`.
+    pub(super) rebalance_threshold: f64,
 }
 
 /// Checks the `[solver]` keys against the solver kind: the keys of the
@@ -43,6 +47,11 @@ pub(super) fn solver_keys(
         ("transfer", s.transfer.as_ref().map(Spanned::span)),
         ("alpha", span(&s.alpha)),
         ("output_interval", span(&s.output_interval)),
+        (
+            "rebalance_every",
+            s.rebalance_every.as_ref().map(Spanned::span),
+        ),
+        ("rebalance_threshold", span(&s.rebalance_threshold)),
     ];
     if s.kind() == SolverKind::Implicit {
         if let Some((key, Some(at))) = explicit_keys.into_iter().find(|(_, at)| at.is_some()) {
@@ -159,6 +168,19 @@ pub(super) fn solver_keys(
         }
         None => end_time / DEFAULT_OUTPUTS as f64,
     };
+    let rebalance_threshold = match &s.rebalance_threshold {
+        Some(t) if !(*t.get_ref() > 1.0 && t.get_ref().is_finite()) => {
+            return Err(src.at(
+                t,
+                format!(
+                    "solver `rebalance_threshold` is the most loaded process's points over the mean: above 1, got {}",
+                    t.get_ref()
+                ),
+            ));
+        }
+        Some(t) => *t.get_ref(),
+        None => DEFAULT_REBALANCE_THRESHOLD,
+    };
     Ok(Some(ExplicitKeys {
         end_time,
         output_interval,
@@ -166,6 +188,11 @@ pub(super) fn solver_keys(
         transfer,
         alpha,
         locking,
+        rebalance_every: s
+            .rebalance_every
+            .as_ref()
+            .map_or(DEFAULT_REBALANCE_EVERY, |e| *e.get_ref()),
+        rebalance_threshold,
     }))
 }
 
@@ -262,6 +289,16 @@ fn blend_alpha(
 
 /// The CFL factor of an explicit scene without `cfl` or `time_step`.
 pub const DEFAULT_CFL: f64 = 0.5;
+
+/// Steps between two counts of an explicit run's points per process on
+/// several processes.
+pub const DEFAULT_REBALANCE_EVERY: usize = 50;
+
+/// The imbalance (most loaded process's points over the mean) past which
+/// an explicit run on several processes deals its cells anew: 10 %, a
+/// step's work being proportional to the points and the wait at the halo
+/// to the largest.
+pub const DEFAULT_REBALANCE_THRESHOLD: f64 = 1.1;
 
 /// Outputs of an explicit scene without `output_interval` (besides the
 /// initial state): `end_time / 20` apart.

@@ -186,6 +186,8 @@ impl<const D: usize> ExplicitRun<D> {
             point_forces: loads.forces,
             timed_forces: loads.timed,
             point_fixities: self.point_fixities,
+            rebalance_every: k.rebalance_every,
+            rebalance_threshold: k.rebalance_threshold,
         }
     }
 }

@@ -317,6 +317,12 @@ pub struct ExplicitSetup<const D: usize> {
     /// Material-point fixities (point, component, velocity), from
     /// `[[point_fixity]]`.
     pub point_fixities: Vec<(usize, usize, f64)>,
+    /// On several processes: steps between two counts of the points per
+    /// process (0: never).
+    pub rebalance_every: usize,
+    /// On several processes: the imbalance past which the cells are dealt
+    /// anew.
+    pub rebalance_threshold: f64,
 }
 
 /// Point forces of one explicit load with a curve: at simulated time t
