@@ -14,8 +14,11 @@
 //! same order, so the run goes on bit for bit; on another number (or from
 //! a one-process checkpoint), the cells are dealt from the points' cells.
 //!
-//! Not yet on several ranks (refused): point forces and point fixities
-//! (they name points by index, which migration changes), the
+//! Point forces travel with their points (`mpm_solver`'s migration).
+//! Not yet on several ranks (refused): loads with a curve (their forces
+//! are set by their place in the points' force list, which migration
+//! changes), material-point fixities (a held point's multiplier changes
+//! the velocities of nodes another rank's points share), the
 //! cell-averaged dilatation.
 
 use std::sync::Arc;
@@ -47,11 +50,16 @@ pub struct Rebalanced {
 /// # Errors
 /// [`SolverError::InvalidInput`] naming it.
 pub(crate) fn supported<const D: usize>(setup: &ExplicitSetup<D>) -> Result<(), SolverError> {
-    let point_loads = !setup.point_forces.is_empty() || !setup.timed_forces.is_empty();
-    if point_loads || !setup.point_fixities.is_empty() {
-        return Err(SolverError::InvalidInput(
-            "point loads and point fixities of an explicit scene on several ranks: not yet (issue 42); run it on one process".into(),
-        ));
+    let refuse = |what: &str| {
+        Err(SolverError::InvalidInput(format!(
+            "{what} of an explicit scene on several ranks: not yet (issue 42); run it on one process"
+        )))
+    };
+    if !setup.timed_forces.is_empty() {
+        return refuse("loads with a curve");
+    }
+    if !setup.point_fixities.is_empty() {
+        return refuse("point fixities");
     }
     Ok(())
 }

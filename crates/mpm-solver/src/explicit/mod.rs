@@ -612,9 +612,11 @@ where
     fn hold_fixed_points(&mut self, points: &mut PointsOf<D, B, L, T>) -> Result<(), SolverError> {
         self.fixed_start.clear();
         let on_ranks = self.on_ranks.is_some();
-        if on_ranks && !(points.fixed_velocity.is_empty() && points.point_force.is_empty()) {
+        // A held point's multiplier changes the velocities of its nodes,
+        // which another rank's points may share without knowing of it.
+        if on_ranks && !points.fixed_velocity.is_empty() {
             return Err(SolverError::InvalidInput(
-                "point forces and material-point fixities are not yet supported on more than one rank".into(),
+                "material-point fixities are not yet supported on more than one rank".into(),
             ));
         }
         for &(p, c, v) in &points.fixed_velocity {
