@@ -267,42 +267,36 @@ fn point_loads_travel_with_their_points() {
     assert!(work > 0.0, "the push does work: {work}");
 }
 
+/// The errors of the column with `extra` appended, run on 2 ranks.
+fn errors_on_two_ranks(extra: &str) -> Vec<String> {
+    let text = format!("{COLLAPSE}{extra}");
+    let (scene, source) = scene::parse(&text, "extra.toml", &[]).unwrap();
+    let problem = Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap();
+    let results = ThreadRanks::run(2, |ranks| {
+        let run = mpm_cases::scene::ranks::rank_run(&problem, Arc::new(ranks)).unwrap();
+        let control = RunControl {
+            ranks: Some(run),
+            ..RunControl::default()
+        };
+        scene::run_explicit(&problem, &control, |_| Ok(())).map(|_| ())
+    });
+    results
+        .into_iter()
+        .map(|r| r.unwrap_err().to_string())
+        .collect()
+}
+
 /// Loads with a curve are set by their place in the points' force list,
 /// which migration changes, and point fixities constrain nodes other ranks
 /// share: refused on several ranks, on every rank with the same message.
 #[test]
-fn an_explicit_load_with_a_curve_on_ranks_is_refused_on_every_rank() {
-    let extra = "\n[[curve]]\nname = \"ramp\"\npoints = [[0.0, 0.0], [1.0, 1.0]]\n\n[[load]]\nkind = \"point\"\nat = [0.5, 0.9]\nforce = [0.0, -1.0]\ncurve = \"ramp\"\n";
-    let text = format!("{COLLAPSE}{extra}");
-    let (scene, source) = scene::parse(&text, "curve.toml", &[]).unwrap();
-    let problem = Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap();
-    let results = ThreadRanks::run(2, |ranks| {
-        let run = mpm_cases::scene::ranks::rank_run(&problem, Arc::new(ranks)).unwrap();
-        let control = RunControl {
-            ranks: Some(run),
-            ..RunControl::default()
-        };
-        scene::run_explicit(&problem, &control, |_| Ok(())).map(|_| ())
-    });
-    for r in results {
-        let e = r.unwrap_err().to_string();
+fn an_explicit_load_with_a_curve_or_a_point_fixity_on_ranks_is_refused_on_every_rank() {
+    let curve = "\n[[curve]]\nname = \"ramp\"\npoints = [[0.0, 0.0], [1.0, 1.0]]\n\n[[load]]\nkind = \"point\"\nat = [0.5, 0.9]\nforce = [0.0, -1.0]\ncurve = \"ramp\"\n";
+    for e in errors_on_two_ranks(curve) {
         assert!(e.contains("loads with a curve"), "{e}");
     }
-    let held = format!(
-        "{COLLAPSE}\n[[point_fixity]]\nregion = {{ box = {{ lower = [0.0, 0.5], upper = [0.07, 1.0] }} }}\nvelocity = {{ y = -0.5 }}\n"
-    );
-    let (scene, source) = scene::parse(&held, "held.toml", &[]).unwrap();
-    let problem = Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap();
-    let results = ThreadRanks::run(2, |ranks| {
-        let run = mpm_cases::scene::ranks::rank_run(&problem, Arc::new(ranks)).unwrap();
-        let control = RunControl {
-            ranks: Some(run),
-            ..RunControl::default()
-        };
-        scene::run_explicit(&problem, &control, |_| Ok(())).map(|_| ())
-    });
-    for r in results {
-        let e = r.unwrap_err().to_string();
+    let held = "\n[[point_fixity]]\nregion = { box = { lower = [0.0, 0.5], upper = [0.07, 1.0] } }\nvelocity = { y = -0.5 }\n";
+    for e in errors_on_two_ranks(held) {
         assert!(e.contains("point fixities"), "{e}");
     }
 }
