@@ -9,7 +9,7 @@
 //! 1e-9 of the largest, energies 1e-10) are far above it and far below
 //! any error of the method.
 
-use std::sync::Arc;
+use super::common;
 
 use mpm_cases::run::{RunControl, Snapshot};
 use mpm_cases::scene::{self, ExplicitEvent, Problem};
@@ -65,11 +65,7 @@ fn on_ranks(problem: &Problem<2>, size: usize) -> Seen {
 /// As [`on_ranks`], the run driven by `control` (checkpoints, resumption).
 fn on_ranks_with(problem: &Problem<2>, size: usize, control: &RunControl) -> Seen {
     let mut all = ThreadRanks::run(size, |ranks| {
-        let run = mpm_cases::scene::ranks::rank_run(problem, Arc::new(ranks)).unwrap();
-        let control = RunControl {
-            ranks: Some(run),
-            ..control.clone()
-        };
+        let control = common::on_ranks(problem, ranks, control);
         run_with(problem, &control)
     });
     for other in &all[1..] {
@@ -273,11 +269,7 @@ fn errors_on_two_ranks(extra: &str) -> Vec<String> {
     let (scene, source) = scene::parse(&text, "extra.toml", &[]).unwrap();
     let problem = Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap();
     let results = ThreadRanks::run(2, |ranks| {
-        let run = mpm_cases::scene::ranks::rank_run(&problem, Arc::new(ranks)).unwrap();
-        let control = RunControl {
-            ranks: Some(run),
-            ..RunControl::default()
-        };
+        let control = common::on_ranks(&problem, ranks, &RunControl::default());
         scene::run_explicit(&problem, &control, |_| Ok(())).map(|_| ())
     });
     results

@@ -11,7 +11,9 @@
 //! stresses and reactions differ only by the order in which the ranks'
 //! sums are added.
 
+use super::common;
 use std::path::Path;
+
 use std::sync::Arc;
 
 use mpm_cases::run::{RunControl, Snapshot};
@@ -168,11 +170,7 @@ where
     Problem<D>: RunScene<D>,
 {
     let mut all = ThreadRanks::run(size, |ranks| {
-        let run = mpm_cases::scene::ranks::rank_run(problem, Arc::new(ranks)).unwrap();
-        let control = RunControl {
-            ranks: Some(run),
-            ..control.clone()
-        };
+        let control = common::on_ranks(problem, ranks, control);
         run_with(problem, &control)
     });
     for other in &all[1..] {

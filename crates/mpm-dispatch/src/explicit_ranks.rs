@@ -29,7 +29,7 @@ use mpm_solver::SolverError;
 use mpm_solver::ranks::{self, Decomposition, Ranks, Reduce};
 
 use crate::explicit::Stepper;
-use crate::on_ranks::{RankRun, gather, imbalance, keep_names};
+use crate::on_ranks::{Part, RankRun, gather, imbalance, keep_names, rows_by_id, to_root};
 use crate::run::Snapshot;
 
 /// A new deal of the cells during a run on several ranks.
@@ -241,62 +241,33 @@ impl<'a> Spread<'a> {
         total: usize,
     ) -> Result<(Vec<f64>, Vec<f64>), SolverError> {
         let ranks = self.run.ranks.as_ref();
-        let ids = run.ids();
-        let flat = run.flat_points();
-        let mut message = Vec::with_capacity(1 + ids.len() + flat.len());
-        message.push(ids.len() as f64);
-        message.extend(ids.iter().map(|&p| p as f64));
-        message.push(run.local_work());
-        message.extend(flat.iter().skip(1));
-        if !self.run.is_root() {
-            ranks.exchange(&[0], &[message], &mut [Vec::new()])?;
-            return ranks::agree(ranks, Ok((Vec::new(), Vec::new())));
-        }
-        let others: Vec<usize> = (1..ranks.size()).collect();
-        let mut incoming = vec![Vec::new(); others.len()];
-        ranks.exchange(&others, &vec![Vec::new(); others.len()], &mut incoming)?;
-        let parts: Vec<&Vec<f64>> = std::iter::once(&message).chain(&incoming).collect();
-        ranks::agree(ranks, self.join(&parts, total))
+        // The rank's work of the point forces, then its records.
+        let mut numbers = run.flat_points();
+        numbers[0] = run.local_work();
+        let joined = match to_root(ranks, run.ids(), &numbers) {
+            Ok(Some(parts)) => self.join(&parts, total),
+            other => other.map(|_| (Vec::new(), Vec::new())),
+        };
+        ranks::agree(ranks, joined)
     }
 
-    /// Rank 0's side of [`Self::checkpoint`]: the parts (rank by rank:
-    /// count, ids, work, records) joined.
-    fn join(&self, parts: &[&Vec<f64>], total: usize) -> Result<(Vec<f64>, Vec<f64>), SolverError> {
-        let bad =
-            |what: &str| SolverError::InvalidInput(format!("a checkpoint of the ranks: {what}"));
+    /// Rank 0's side of [`Self::checkpoint`]: the parts (each its work,
+    /// then its records) joined into the records by id, the count first,
+    /// and how the ranks held them: their number, each one's work, the deal
+    /// of the cells, each point's rank and place.
+    fn join(&self, parts: &[Part], total: usize) -> Result<(Vec<f64>, Vec<f64>), SolverError> {
         let (size, cells) = (parts.len(), self.rank_of_cell.len());
-        let numbers = parts.iter().map(|m| m.len()).sum::<usize>();
-        let per = (numbers.saturating_sub(2 * size + total)) / total.max(1);
-        let mut whole = vec![0.0; 1 + total * per];
-        whole[0] = total as f64;
-        let mut held = vec![0.0; 1 + size + cells + 2 * total];
-        held[0] = size as f64;
-        for (c, &r) in self.rank_of_cell.iter().enumerate() {
-            held[1 + size + c] = r as f64;
-        }
-        let place = 1 + size + cells;
-        let mut seen = vec![false; total];
-        for (rank, m) in parts.iter().enumerate() {
-            let n = m.first().copied().unwrap_or(0.0) as usize;
-            if m.len() != 2 + n * (1 + per) {
-                return Err(bad("a part of another length than its points"));
-            }
-            held[1 + rank] = m[1 + n];
-            let records = m[2 + n..].chunks_exact(per.max(1));
-            for (slot, (&id, record)) in m[1..1 + n].iter().zip(records).enumerate() {
-                let id = id as usize;
-                match seen.get_mut(id) {
-                    Some(s) if !*s => *s = true,
-                    _ => return Err(bad("a point twice or beyond the problem")),
-                }
-                whole[1 + id * per..1 + (id + 1) * per].copy_from_slice(record);
-                held[place + 2 * id] = rank as f64;
-                held[place + 2 * id + 1] = slot as f64;
-            }
-        }
-        if seen.iter().any(|s| !s) {
-            return Err(bad("a point of no rank"));
-        }
+        let numbers = parts.iter().map(|p| p.numbers.len()).sum::<usize>();
+        let per = numbers.saturating_sub(size) / total.max(1);
+        let (records, places) = rows_by_id(parts, per, 1, total).map_err(|what| {
+            SolverError::InvalidInput(format!("a checkpoint of the ranks: {what}"))
+        })?;
+        let whole = std::iter::once(total as f64).chain(records).collect();
+        let mut held = Vec::with_capacity(1 + size + cells + 2 * total);
+        held.push(size as f64);
+        held.extend(parts.iter().map(|p| p.numbers[0]));
+        held.extend(self.rank_of_cell.iter().map(|&r| r as f64));
+        held.extend(places.iter().flat_map(|&(r, slot)| [r as f64, slot as f64]));
         Ok((whole, held))
     }
 

@@ -210,42 +210,14 @@ pub fn gather(
         domain: flags[1] > 0.0,
     };
     let width = rows.width();
-    let mut message = Vec::with_capacity(1 + ids.len() * (width + 1));
-    message.push(ids.len() as f64);
-    message.extend(ids.iter().map(|&p| p as f64));
+    let mut numbers = Vec::with_capacity(ids.len() * width);
     for p in 0..ids.len() {
-        rows.write(local, p, &mut message);
+        rows.write(local, p, &mut numbers);
     }
-    let (rank, size) = (ranks.rank(), ranks.size());
-    if rank != 0 {
-        let mut incoming = [Vec::new()];
-        ranks.exchange(&[0], &[message], &mut incoming)?;
+    let Some(parts) = to_root(ranks, ids, &numbers)? else {
         return Ok(None);
-    }
-    let others: Vec<usize> = (1..size).collect();
-    let outgoing = vec![Vec::new(); others.len()];
-    let mut incoming = vec![Vec::new(); others.len()];
-    ranks.exchange(&others, &outgoing, &mut incoming)?;
-    let mut all = vec![f64::NAN; total * width];
-    let mut seen = vec![false; total];
-    for m in std::iter::once(&message).chain(&incoming) {
-        let n = m.first().copied().unwrap_or(0.0) as usize;
-        let (head, body) = m.split_at((1 + n).min(m.len()));
-        if body.len() != n * width {
-            return Err(gathered("a message of another length than its points"));
-        }
-        for (k, &id) in head.iter().skip(1).enumerate() {
-            let id = id as usize;
-            match seen.get_mut(id) {
-                Some(s) if !*s => *s = true,
-                _ => return Err(gathered("a point named twice or beyond the problem")),
-            }
-            all[id * width..(id + 1) * width].copy_from_slice(&body[k * width..(k + 1) * width]);
-        }
-    }
-    if seen.iter().any(|s| !s) {
-        return Err(gathered("a point of no rank"));
-    }
+    };
+    let (all, _) = rows_by_id(&parts, width, 0, total).map_err(|e| gathered(&e))?;
     // Rank 0's checkpoint, when the run keeps them, is the whole
     // problem's already (the ranks' parts joined when it was made).
     let mut whole = Snapshot {
@@ -259,6 +231,88 @@ pub fn gather(
         rows.read(row, &mut whole);
     }
     Ok(Some(whole))
+}
+
+/// One rank's part of the points, collected on rank 0 ([`to_root`]): the
+/// problem's indices of its points, in its order, and its numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Part {
+    /// The problem's index of each of the rank's points.
+    pub ids: Vec<usize>,
+    /// What the rank sent about them.
+    pub numbers: Vec<f64>,
+}
+
+/// Every rank's `ids` and `numbers` sent to rank 0: there, the parts in
+/// rank order; `None` on the other ranks. Collective; one message per rank.
+///
+/// # Errors
+/// The transport's; on rank 0, a message that does not parse.
+pub fn to_root(
+    ranks: &dyn Ranks,
+    ids: &[usize],
+    numbers: &[f64],
+) -> Result<Option<Vec<Part>>, SolverError> {
+    let mut message = Vec::with_capacity(1 + ids.len() + numbers.len());
+    message.push(ids.len() as f64);
+    message.extend(ids.iter().map(|&p| p as f64));
+    message.extend_from_slice(numbers);
+    if ranks.rank() != 0 {
+        ranks.exchange(&[0], &[message], &mut [Vec::new()])?;
+        return Ok(None);
+    }
+    let others: Vec<usize> = (1..ranks.size()).collect();
+    let mut incoming = vec![Vec::new(); others.len()];
+    ranks.exchange(&others, &vec![Vec::new(); others.len()], &mut incoming)?;
+    let part = |m: &Vec<f64>| {
+        let n = m.first().copied().unwrap_or(0.0) as usize;
+        let head = m
+            .get(1..1 + n)
+            .ok_or_else(|| gathered("a message shorter than its ids"))?;
+        Ok(Part {
+            ids: head.iter().map(|&i| i as usize).collect(),
+            numbers: m[1 + n..].to_vec(),
+        })
+    };
+    let parts = std::iter::once(&message).chain(&incoming).map(part);
+    parts.collect::<Result<_, SolverError>>().map(Some)
+}
+
+/// Each point's rank and place in that rank's part, by id.
+pub type Places = Vec<(usize, usize)>;
+
+/// The rows of `width` numbers the `parts` hold after `skip` numbers of
+/// their own, one per point, placed by id: all `total` rows, and each
+/// point's rank and place in that rank's part.
+///
+/// # Errors
+/// A part of another length than its points, a point twice, beyond
+/// `total` or in no part.
+pub fn rows_by_id(
+    parts: &[Part],
+    width: usize,
+    skip: usize,
+    total: usize,
+) -> Result<(Vec<f64>, Places), String> {
+    let mut all = vec![f64::NAN; total * width];
+    let mut place = vec![(usize::MAX, 0); total];
+    for (rank, part) in parts.iter().enumerate() {
+        if part.numbers.len() != skip + part.ids.len() * width {
+            return Err("a part of another length than its points".into());
+        }
+        let rows = part.numbers[skip..].chunks_exact(width.max(1));
+        for (slot, (&id, row)) in part.ids.iter().zip(rows).enumerate() {
+            match place.get_mut(id) {
+                Some(p) if p.0 == usize::MAX => *p = (rank, slot),
+                _ => return Err("a point twice or beyond the problem".into()),
+            }
+            all[id * width..(id + 1) * width].copy_from_slice(row);
+        }
+    }
+    if place.iter().any(|p| p.0 == usize::MAX) {
+        return Err("a point of no rank".into());
+    }
+    Ok((all, place))
 }
 
 fn gathered(what: &str) -> SolverError {

@@ -456,28 +456,25 @@ fn whole_points<const D: usize, H: Copy + Default + Flat, Dom: Copy + Flat>(
     total: usize,
 ) -> Result<Vec<f64>, SolverError> {
     let ranks = run.ranks.as_ref();
-    let mut message = Vec::with_capacity(1 + ids.len());
-    message.push(ids.len() as f64);
-    message.extend(ids.iter().map(|&p| p as f64));
-    message.extend(points.to_flat());
-    if !run.is_root() {
-        ranks.exchange(&[0], &[message], &mut [Vec::new()])?;
-        return ranks::agree(ranks, Ok(Vec::new()));
-    }
-    let others: Vec<usize> = (1..ranks.size()).collect();
-    let mut incoming = vec![Vec::new(); others.len()];
-    ranks.exchange(&others, &vec![Vec::new(); others.len()], &mut incoming)?;
-    let joined = (|| {
-        let mut ids_of = Vec::new();
-        let mut parts = Vec::new();
-        for m in std::iter::once(&message).chain(&incoming) {
-            let n = m.first().copied().unwrap_or(0.0) as usize;
-            let (head, flat) = m.split_at((1 + n).min(m.len()));
-            ids_of.push(head.iter().skip(1).map(|&i| i as usize).collect::<Vec<_>>());
-            parts.push(MaterialPoints::<D, H, Dom>::from_flat(flat)?);
-        }
-        let parts: Vec<(&[usize], _)> = ids_of.iter().map(Vec::as_slice).zip(parts).collect();
-        Ok(MaterialPoints::join(&parts, total)?.to_flat())
-    })();
+    let joined = match on_ranks::to_root(ranks, ids, &points.to_flat()) {
+        Ok(Some(parts)) => join_flat::<D, H, Dom>(&parts, total),
+        other => other.map(|_| Vec::new()),
+    };
     ranks::agree(ranks, joined)
+}
+
+/// The ranks' parts of [`whole_points`] joined into the whole problem's.
+fn join_flat<const D: usize, H: Copy + Default + Flat, Dom: Copy + Flat>(
+    parts: &[on_ranks::Part],
+    total: usize,
+) -> Result<Vec<f64>, SolverError> {
+    let points = (parts.iter())
+        .map(|p| {
+            Ok((
+                p.ids.as_slice(),
+                MaterialPoints::<D, H, Dom>::from_flat(&p.numbers)?,
+            ))
+        })
+        .collect::<Result<Vec<_>, SolverError>>()?;
+    Ok(MaterialPoints::join(&points, total)?.to_flat())
 }

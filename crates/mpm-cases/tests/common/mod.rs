@@ -182,3 +182,17 @@ pub fn run_outputs(dir: &Path) -> BTreeMap<String, Vec<u8>> {
         })
         .collect()
 }
+
+/// `control` run as one of `ranks` with the deal of `problem` (what
+/// `mpirun` gives `mpm run`, here on threads).
+pub fn on_ranks<const D: usize>(
+    problem: &mpm_cases::scene::Problem<D>,
+    ranks: mpm_solver::ranks::ThreadRanks,
+    control: &mpm_cases::run::RunControl,
+) -> mpm_cases::run::RunControl {
+    let run = mpm_cases::scene::ranks::rank_run(problem, std::sync::Arc::new(ranks)).unwrap();
+    mpm_cases::run::RunControl {
+        ranks: Some(run),
+        ..control.clone()
+    }
+}

@@ -149,7 +149,27 @@ pub(super) fn solver_keys(
         .as_ref()
         .map_or(TransferKind::default(), |t| *t.get_ref());
     let alpha = blend_alpha(s, src, transfer)?;
-    let output_interval = match &s.output_interval {
+    let output_interval = output_interval(s, src, end_time)?;
+    let rebalance_threshold = rebalance_threshold(s, src)?;
+    Ok(Some(ExplicitKeys {
+        end_time,
+        output_interval,
+        time_step,
+        transfer,
+        alpha,
+        locking,
+        rebalance_every: s
+            .rebalance_every
+            .as_ref()
+            .map_or(DEFAULT_REBALANCE_EVERY, |e| *e.get_ref()),
+        rebalance_threshold,
+    }))
+}
+
+/// `output_interval` (s), positive and at most 1e6 outputs before
+/// `end_time`; `end_time` / [`DEFAULT_OUTPUTS`] without it.
+fn output_interval(s: &SolverSpec, src: &SceneSource, end_time: f64) -> Result<f64, SceneError> {
+    Ok(match &s.output_interval {
         Some(o) => {
             let value = *o.get_ref();
             if value <= 0.0 {
@@ -167,8 +187,13 @@ pub(super) fn solver_keys(
             value
         }
         None => end_time / DEFAULT_OUTPUTS as f64,
-    };
-    let rebalance_threshold = match &s.rebalance_threshold {
+    })
+}
+
+/// `rebalance_threshold`, above 1; [`DEFAULT_REBALANCE_THRESHOLD`]
+/// without it.
+fn rebalance_threshold(s: &SolverSpec, src: &SceneSource) -> Result<f64, SceneError> {
+    Ok(match &s.rebalance_threshold {
         Some(t) if !(*t.get_ref() > 1.0 && t.get_ref().is_finite()) => {
             return Err(src.at(
                 t,
@@ -180,20 +205,7 @@ pub(super) fn solver_keys(
         }
         Some(t) => *t.get_ref(),
         None => DEFAULT_REBALANCE_THRESHOLD,
-    };
-    Ok(Some(ExplicitKeys {
-        end_time,
-        output_interval,
-        time_step,
-        transfer,
-        alpha,
-        locking,
-        rebalance_every: s
-            .rebalance_every
-            .as_ref()
-            .map_or(DEFAULT_REBALANCE_EVERY, |e| *e.get_ref()),
-        rebalance_threshold,
-    }))
+    })
 }
 
 /// The explicit time step of `s`: `cfl` or `time_step` (not both), a
