@@ -90,15 +90,37 @@ fn main() {
     #[cfg(not(feature = "mpi"))]
     let ranks = None;
     if let Err(e) = run_cli(Cli::parse(), ranks.clone()) {
-        match ranks {
-            Some(r) => eprintln!("error (rank {} of {}): {e:#}", r.0.rank(), r.0.size()),
-            None => eprintln!("error: {e:#}"),
+        let message = match &ranks {
+            Some(r) => format!("error (rank {} of {}): {e:#}\n", r.0.rank(), r.0.size()),
+            None => format!("error: {e:#}\n"),
+        };
+        // One write, not one per formatted piece (stderr is unbuffered):
+        // the processes of a job share mpirun's stderr, and pieces of their
+        // messages would interleave.
+        let _ = std::io::Write::write_all(&mut std::io::stderr().lock(), message.as_bytes());
+        // A refusal every process reaches waits until every process has
+        // said it: the first to exit makes mpirun end the others.
+        if let (Some(r), Some(EveryProcess(_))) = (&ranks, e.downcast_ref()) {
+            let _ = r.0.all_reduce(&mut [0.0], mpm_solver::ranks::Reduce::Sum);
         }
         // Without finalising: a rank that failed alone must not wait for
         // the others; mpirun ends the job.
         std::process::exit(1);
     }
 }
+
+/// An error every process of a job reaches from the same input (the
+/// command line), before any communication.
+#[derive(Debug)]
+struct EveryProcess(String);
+
+impl std::fmt::Display for EveryProcess {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for EveryProcess {}
 
 /// The MPI processes this program was started on by `mpirun`, when more
 /// than one.
@@ -187,9 +209,10 @@ fn run_cli(cli: Cli, ranks: Option<SharedRanks>) -> Result<()> {
                 })?
             };
             if ranks.is_some() && !is_scene {
-                return Err(anyhow!(
+                return Err(EveryProcess(format!(
                     "the built-in cases run on one process; run a scene file on several (`mpm scene --case {name} > {name}.toml`)"
-                ));
+                ))
+                .into());
             }
             let session = Session {
                 ranks,

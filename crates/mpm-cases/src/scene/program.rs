@@ -42,7 +42,9 @@ where
 
     let problem =
         Problem::<D>::build_in(scene, source, scene.solver.padding(), &session.scene_dir)?;
-    for w in &problem.warnings {
+    // Once per job, not once per process.
+    let root = session.ranks.as_ref().is_none_or(|r| r.0.rank() == 0);
+    for w in problem.warnings.iter().filter(|_| root) {
         eprintln!("warning: {}: {w}", source.origin());
     }
     if let Some(shared) = &session.ranks {
