@@ -19,16 +19,16 @@ fn main() {
             std::process::exit(1);
         }
     };
-    // MPI's headers: petscsys.h includes mpi.h.
+    // MPI's headers (petscsys.h includes mpi.h) and library (the wrapper
+    // asks MPI for the number of processes).
     let mpi = pkg_config::Config::new()
-        .cargo_metadata(false)
         .probe("ompi-c")
-        .or_else(|_| pkg_config::Config::new().cargo_metadata(false).probe("mpi"));
+        .or_else(|_| pkg_config::Config::new().probe("mpi"));
     let mut builder = bindgen::Builder::default()
         .header("wrapper.h")
-        .allowlist_function("(KSP|PC|Mat|Vec|Petsc)\\w*")
-        .allowlist_var("PETSC_\\w*|(KSP|PC|MAT|VEC|INSERT|ADD)\\w*")
-        .allowlist_type("(KSP|PC|Mat|Vec|Petsc|Insert)\\w*")
+        .allowlist_function("(KSP|PC|Mat|Vec|Petsc)\\w*|MPI_Comm_size")
+        .allowlist_var("PETSC_\\w*|(KSP|PC|MAT|VEC|INSERT|ADD|SCATTER)\\w*")
+        .allowlist_type("(KSP|PC|Mat|Vec|Petsc|Insert|Scatter)\\w*")
         .opaque_type("_p_\\w*")
         .derive_debug(false)
         .layout_tests(false)

@@ -13,12 +13,14 @@
 //!   points), 10 steps of 0.01 mm; rank 0's seconds per stage from
 //!   `steps.csv`: the per-point work (stress updates, tangents) is split
 //!   over the ranks, the stiffness is summed over them and rank 0 solves
-//!   it alone (the distributed solve is still to come, issue 42).
+//!   it alone with the built-in solver;
+//! - the same plate with PETSc over the processes (GMRES + GAMG, each rank
+//!   handing PETSc the entries of its own points): the solve divides too.
 //!
 //! Configurations: 1 process × 1 thread, 1 process × 2 threads, 2
 //! processes × 1 thread (`--bind-to none`). Written to
-//! `docs/src/benchmarks/ranks_scenes.md`. Needs Open MPI (`mpirun`); builds
-//! `mpm` with `--features mpi` itself.
+//! `docs/src/benchmarks/ranks_scenes.md`. Needs Open MPI (`mpirun`) and
+//! PETSc; builds `mpm` with `--features mpi,petsc` itself.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -83,6 +85,10 @@ const IMPLICIT: Case = Case {
     ],
 };
 
+/// PETSc's options of the plate's solve over the processes (F-patch's
+/// system is not symmetric).
+const PETSC: &str = "solver.linear={ petsc = \"-ksp_type gmres -pc_type gamg\" }";
+
 /// The quick variant: smaller problems, one repetition.
 const QUICK_EXPLICIT: &[&str] = &[
     "mesh.cells=[192,80]",
@@ -112,8 +118,10 @@ pub fn run(quick: bool, root: &Path, docs: &Path) -> Result<()> {
     let scratch = std::env::temp_dir().join(format!("xtask-ranks-{}", std::process::id()));
     let explicit_set = if quick { QUICK_EXPLICIT } else { EXPLICIT.set };
     let implicit_set = if quick { QUICK_IMPLICIT } else { IMPLICIT.set };
+    let petsc_set: Vec<&str> = implicit_set.iter().copied().chain([PETSC]).collect();
     let mut explicit = vec![Vec::new(); LAYOUTS.len()];
     let mut implicit = vec![Vec::new(); LAYOUTS.len()];
+    let mut petsc = vec![Vec::new(); LAYOUTS.len()];
     let load = machine::load_average();
     for r in 0..repeats {
         for (k, layout) in LAYOUTS.iter().enumerate() {
@@ -124,6 +132,9 @@ pub fn run(quick: bool, root: &Path, docs: &Path) -> Result<()> {
             let dir = scratch.join(format!("implicit-{k}-{r}"));
             run_scene(&exe, root, IMPLICIT.file, implicit_set, *layout, &dir)?;
             implicit[k].push(implicit_timing(&dir)?);
+            let dir = scratch.join(format!("petsc-{k}-{r}"));
+            run_scene(&exe, root, IMPLICIT.file, &petsc_set, *layout, &dir)?;
+            petsc[k].push(implicit_timing(&dir)?);
         }
     }
     std::fs::remove_dir_all(&scratch).ok();
@@ -140,9 +151,11 @@ pub fn run(quick: bool, root: &Path, docs: &Path) -> Result<()> {
     )?;
     write_case(&mut page, EXPLICIT.name, explicit_set, &explicit)?;
     write_case(&mut page, IMPLICIT.name, implicit_set, &implicit)?;
+    let petsc_name = format!("{} and PETSc (GMRES + GAMG)", IMPLICIT.name);
+    write_case(&mut page, &petsc_name, &petsc_set, &petsc)?;
     writeln!(
         page,
-        "In the implicit run on 2 processes rank 0 still solves the whole system alone (`solve`), so only the per-point stages divide; PETSc's distributed solve is the next step (issue 42). `other` is the wall time outside the named stages: in the explicit run on 2 processes the halo exchange, the migration, the counts for the balance and the reductions.\n"
+        "With the built-in linear solver, rank 0 solves the whole (summed) system alone on 2 processes (`solve`), so only the per-point stages divide. With PETSc each process hands it the entries of its own points and the Krylov method and GAMG run over both processes; on 1 process PETSc runs single-threaded whatever the thread count. `other` is the wall time outside the named stages: in the explicit run on 2 processes the halo exchange, the migration, the counts for the balance and the reductions.\n"
     )?;
     let page = machine::stamp_duration(page, start);
     let path = docs.join("benchmarks/ranks_scenes.md");
@@ -154,12 +167,19 @@ pub fn run(quick: bool, root: &Path, docs: &Path) -> Result<()> {
 /// Builds `mpm` with MPI and returns its path.
 fn build(root: &Path) -> Result<PathBuf> {
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args(["build", "--release", "-p", "mpm-cases", "--features", "mpi"])
+        .args([
+            "build",
+            "--release",
+            "-p",
+            "mpm-cases",
+            "--features",
+            "mpi,petsc",
+        ])
         .current_dir(root)
         .status()
         .context("running cargo build")?;
     if !status.success() {
-        bail!("cargo build --release -p mpm-cases --features mpi failed");
+        bail!("cargo build --release -p mpm-cases --features mpi,petsc failed");
     }
     let target =
         std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);

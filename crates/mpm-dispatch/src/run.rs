@@ -316,6 +316,13 @@ where
         setup.newton,
     );
     if let Some(linear) = external {
+        if control.ranks.is_some() && linear.solves_over_ranks() && control.export_tangent {
+            return Err(SolverError::InvalidInput(
+                "--export-tangent writes the whole stiffness, which no process holds when \
+                 PETSc solves over the processes; export it from a run on one process"
+                    .into(),
+            ));
+        }
         solver.set_linear_solver(linear);
     }
     let total = points.len();

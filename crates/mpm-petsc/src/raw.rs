@@ -146,6 +146,25 @@ fn world() -> ffi::MPI_Comm {
     unsafe { ffi::PETSC_COMM_WORLD }
 }
 
+/// The number of processes PETSc's solvers run over
+/// (`PETSC_COMM_WORLD`'s size: one unless started by `mpirun -n N`).
+///
+/// # Errors
+/// PETSc failed.
+pub fn processes(_s: &Session) -> Result<usize, PetscError> {
+    let mut size: c_int = 0;
+    // SAFETY: the world communicator of an initialised PETSc; out-pointer.
+    check(
+        unsafe { ffi::MPI_Comm_size(world(), &mut size) },
+        "MPI_Comm_size",
+    )?;
+    usize::try_from(size).map_err(|_| PetscError::Size)
+}
+
+/// PETSc's `PETSC_DECIDE` as a local size: PETSc splits the rows evenly
+/// over the processes.
+pub const DECIDE: Int = ffi::PETSC_DECIDE as Int;
+
 /// One solver's options in PETSc's global database under a prefix of its
 /// own (`-mpm3_ksp_type cg`), so that the objects PETSc creates inside the
 /// solver (block Jacobi's sub-solvers, `-sub_pc_type`) find them too;
@@ -311,8 +330,9 @@ impl Matrix {
         )
     }
 
-    /// Sets the near-null space spanned by `modes` (orthonormal vectors of
-    /// the matrix's layout), which GAMG uses to build its coarse spaces.
+    /// Sets the near-null space spanned by `modes` (orthonormal whole
+    /// vectors, the same on every process), which GAMG uses to build its
+    /// coarse spaces.
     ///
     /// # Errors
     /// PETSc refused the space.
@@ -324,7 +344,7 @@ impl Matrix {
         let mut vectors = Vec::with_capacity(modes.len());
         for mode in modes {
             let mut v = self.vector(s)?;
-            v.write(s, mode)?;
+            v.write_whole(s, mode)?;
             vectors.push(v);
         }
         let raw: Vec<ffi::Vec> = vectors.iter().map(|v| v.0).collect();
@@ -423,6 +443,80 @@ impl Vector {
             }
         }
         Ok(())
+    }
+
+    /// This process's rows `lo..hi` of the vector.
+    ///
+    /// # Errors
+    /// PETSc failed.
+    pub fn owned(&self, _s: &Session) -> Result<std::ops::Range<usize>, PetscError> {
+        let (mut lo, mut hi): (Int, Int) = (0, 0);
+        // SAFETY: a live vector; out-pointers.
+        check(
+            unsafe { ffi::VecGetOwnershipRange(self.0, &mut lo, &mut hi) },
+            "VecGetOwnershipRange",
+        )?;
+        let index = |i: Int| usize::try_from(i).map_err(|_| PetscError::Size);
+        Ok(index(lo)?..index(hi)?)
+    }
+
+    /// Copies this process's rows from `whole`, the whole vector (the same
+    /// on every process).
+    ///
+    /// # Errors
+    /// `whole` is shorter than the rows, or PETSc failed.
+    pub fn write_whole(&mut self, s: &Session, whole: &[f64]) -> Result<(), PetscError> {
+        let rows = self.owned(s)?;
+        let part = whole.get(rows.clone()).ok_or(PetscError::Length {
+            expected: rows.end,
+            got: whole.len(),
+        })?;
+        self.write(s, part)
+    }
+
+    /// The whole vector into `whole` on every process (a scatter to all
+    /// processes; collective).
+    ///
+    /// # Errors
+    /// The length is not the vector's, or PETSc failed.
+    pub fn read_whole(&self, s: &Session, whole: &mut [f64]) -> Result<(), PetscError> {
+        let mut scatter: ffi::VecScatter = ptr::null_mut();
+        let mut all: ffi::Vec = ptr::null_mut();
+        // SAFETY: a live vector; the scatter and the sequential vector it
+        // creates are owned by `Vector` (destroyed when dropped) and
+        // destroyed below.
+        unsafe {
+            check(
+                ffi::VecScatterCreateToAll(self.0, &mut scatter, &mut all),
+                "VecScatterCreateToAll",
+            )?;
+            let all = Vector(all);
+            let moved = check(
+                ffi::VecScatterBegin(
+                    scatter,
+                    self.0,
+                    all.0,
+                    ffi::INSERT_VALUES,
+                    ffi::SCATTER_FORWARD,
+                ),
+                "VecScatterBegin",
+            )
+            .and_then(|()| {
+                check(
+                    ffi::VecScatterEnd(
+                        scatter,
+                        self.0,
+                        all.0,
+                        ffi::INSERT_VALUES,
+                        ffi::SCATTER_FORWARD,
+                    ),
+                    "VecScatterEnd",
+                )
+            });
+            ffi::VecScatterDestroy(&mut scatter);
+            moved?;
+            all.read(s, whole)
+        }
     }
 
     fn local_len(&self) -> usize {

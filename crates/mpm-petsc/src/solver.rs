@@ -35,12 +35,18 @@ pub struct PetscLinear {
     checked_options: bool,
     last: Option<Factorisation>,
     iterations: usize,
+    /// Whether PETSc runs over more than one process.
+    over_ranks: bool,
 }
 
 /// What one load step's pattern holds.
 struct Step {
     n: usize,
     nnz: usize,
+    /// Over ranks: the positions of this rank's entries in the pattern,
+    /// and their values gathered for PETSc; empty otherwise.
+    entries: Vec<usize>,
+    part: Vec<f64>,
     matrix: Matrix,
     ksp: Krylov,
     options: Options,
@@ -72,6 +78,10 @@ impl PetscLinear {
             checked_options: false,
             last: None,
             iterations: 0,
+            // An error here surfaces at the first analysis.
+            over_ranks: raw::lock()
+                .and_then(|s| raw::processes(&s))
+                .is_ok_and(|n| n > 1),
         }
     }
 
@@ -94,37 +104,56 @@ impl PetscLinear {
             .any(|w| w[0] == "-pc_type" && w[1] == "gamg")
     }
 
-    /// The pattern's COO pairs (CSC order, so values need no reordering).
+    /// The COO pairs of the pattern's entries at `entries` (positions,
+    /// ascending), or of all of them (CSC order, so values need no
+    /// reordering).
     fn coo(
         n: usize,
         col_ptr: &[usize],
         row_idx: &[usize],
+        entries: Option<&[usize]>,
     ) -> Result<(Vec<Int>, Vec<Int>), PetscError> {
         let index = |i: usize| Int::try_from(i).map_err(|_| PetscError::Size);
-        let mut rows = Vec::with_capacity(row_idx.len());
-        let mut cols = Vec::with_capacity(row_idx.len());
+        let count = entries.map_or(row_idx.len(), <[usize]>::len);
+        let mut rows = Vec::with_capacity(count);
+        let mut cols = Vec::with_capacity(count);
+        let mut wanted = entries.map(|e| e.iter().peekable());
         for c in 0..n {
             let col = index(c)?;
-            for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
-                rows.push(index(r)?);
+            for at in col_ptr[c]..col_ptr[c + 1] {
+                if let Some(w) = &mut wanted {
+                    if w.next_if_eq(&&at).is_none() {
+                        continue;
+                    }
+                }
+                rows.push(index(row_idx[at])?);
                 cols.push(col);
             }
+        }
+        if rows.len() != count {
+            return Err(PetscError::Length {
+                expected: count,
+                got: rows.len(),
+            });
         }
         Ok((rows, cols))
     }
 
+    /// The step of the pattern, of its `entries` only over ranks.
     fn build_step(
         &self,
         n: usize,
         col_ptr: &[usize],
         row_idx: &[usize],
         symmetric: bool,
+        entries: Option<&[usize]>,
     ) -> Result<Step, PetscError> {
-        let (mut rows, mut cols) = Self::coo(n, col_ptr, row_idx)?;
+        let (mut rows, mut cols) = Self::coo(n, col_ptr, row_idx, entries)?;
         let size = Int::try_from(n).map_err(|_| PetscError::Size)?;
+        let local = if entries.is_some() { raw::DECIDE } else { size };
         let max_it = Int::try_from(self.tolerances.max_iterations).unwrap_or(Int::MAX);
         let s = raw::lock()?;
-        let matrix = Matrix::coo(&s, size, size, &mut rows, &mut cols, symmetric)?;
+        let matrix = Matrix::coo(&s, local, size, &mut rows, &mut cols, symmetric)?;
         let options = Options::new(&s, &self.options)?;
         let ksp = Krylov::new(&s, &matrix, &options, self.tolerances.rel_tolerance, max_it)?;
         let b = matrix.vector(&s)?;
@@ -132,6 +161,8 @@ impl PetscLinear {
         Ok(Step {
             n,
             nnz: row_idx.len(),
+            entries: entries.map(<[usize]>::to_vec).unwrap_or_default(),
+            part: Vec::new(),
             matrix,
             ksp,
             options,
@@ -152,7 +183,45 @@ impl LinearSolver for PetscLinear {
         self.step = None;
         self.modes.clear();
         check_pattern(n, col_ptr, row_idx)?;
-        self.step = Some(self.build_step(n, col_ptr, row_idx, symmetric)?);
+        if self.over_ranks {
+            return Err(LinearSolveError::Configuration {
+                library: "PETSc",
+                message: "PETSc runs over several processes: the system must come in \
+                          parts, one per rank of a distributed run"
+                    .into(),
+            });
+        }
+        self.step = Some(self.build_step(n, col_ptr, row_idx, symmetric, None)?);
+        Ok(())
+    }
+
+    fn solves_over_ranks(&self) -> bool {
+        self.over_ranks
+    }
+
+    fn analyse_part(
+        &mut self,
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        symmetric: bool,
+        entries: &[usize],
+    ) -> Result<(), LinearSolveError> {
+        if !self.over_ranks {
+            return self.analyse(n, col_ptr, row_idx, symmetric);
+        }
+        self.step = None;
+        self.modes.clear();
+        check_pattern(n, col_ptr, row_idx)?;
+        let within = entries.last().is_none_or(|&e| e < row_idx.len());
+        if !within || entries.windows(2).any(|w| w[0] >= w[1]) {
+            return Err(LinearSolveError::InvalidPattern {
+                n,
+                reason: "a rank's entries must be ascending positions in the pattern",
+            });
+        }
+        let step = self.build_step(n, col_ptr, row_idx, symmetric, Some(entries))?;
+        self.step = Some(step);
         Ok(())
     }
 
@@ -166,12 +235,18 @@ impl LinearSolver for PetscLinear {
         check_dimensions(step.nnz, step.n, values, rhs)?;
         let b_norm = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
         let s = raw::lock()?;
-        step.matrix.set_values(&s, values)?;
+        if self.over_ranks {
+            step.part.clear();
+            step.part.extend(step.entries.iter().map(|&e| values[e]));
+            step.matrix.set_values(&s, &step.part)?;
+        } else {
+            step.matrix.set_values(&s, values)?;
+        }
         if !self.modes.is_empty() {
             step.matrix.set_near_null_space(&s, &self.modes)?;
             self.modes.clear();
         }
-        step.b.write(&s, rhs)?;
+        step.b.write_whole(&s, rhs)?;
         let outcome = step.ksp.solve(&s, &step.b, &mut step.x)?;
         if !self.checked_options {
             let unused = step.options.unused(&s)?;
@@ -197,7 +272,7 @@ impl LinearSolver for PetscLinear {
                 ),
             });
         }
-        step.x.read(&s, rhs)?;
+        step.x.read_whole(&s, rhs)?;
         if let Some(dof) = rhs.iter().position(|v| !v.is_finite()) {
             return Err(LinearSolveError::NonFinite {
                 factorisation: Factorisation::Iterative,

@@ -25,11 +25,12 @@
 //! 5, the same on every rank count.
 #![allow(clippy::unwrap_used)]
 
-use mpm_solver::ranks::ThreadRanks;
+use mpm_solver::linear::FaerDirect;
 use mpm_solver::ranks::strip_load::{
     self, Deal, Differences, Outcome, POINTS, Treatment, differences, yielded,
 };
-use mpm_solver::{NewtonOptions, SolverError};
+use mpm_solver::ranks::{Ranks, Reduce, ThreadRanks};
+use mpm_solver::{Factorisation, LinearSolveError, LinearSolver, NewtonOptions, SolverError};
 
 fn on_threads(size: usize, treatment: Treatment, deal: Deal) -> Vec<Result<Outcome, SolverError>> {
     ThreadRanks::run(size, |r| strip_load::on_ranks(Box::new(r), treatment, deal))
@@ -148,5 +149,117 @@ fn a_patch_split_between_ranks_is_refused() {
         let run = run.unwrap();
         assert_eq!(run.residuals.len(), single.residuals.len());
         assert!(differences(&single, &run).displacement <= 1e-8);
+    }
+}
+
+/// A linear solver over ranks ([`LinearSolver::solves_over_ranks`]) made
+/// of the direct solver and a second group of thread ranks: it adds the
+/// ranks' own values at the entries each says its points touch, then
+/// solves the whole system on every rank. If the entries missed one that a
+/// rank's points add to, that contribution would be lost and the steps
+/// would differ by far more than rounding; with them right, each sum is
+/// the replicated path's sum (the same additions, in rank order, with
+/// zeros for the entries a rank does not touch), so the runs agree bit
+/// for bit.
+#[derive(Debug)]
+struct Together {
+    ranks: ThreadRanks,
+    direct: FaerDirect,
+    entries: Vec<usize>,
+    whole: Vec<f64>,
+}
+
+impl LinearSolver for Together {
+    fn analyse(
+        &mut self,
+        _: usize,
+        _: &[usize],
+        _: &[usize],
+        _: bool,
+    ) -> Result<(), LinearSolveError> {
+        Err(LinearSolveError::Configuration {
+            library: "test",
+            message: "a solver over ranks is analysed by its parts".into(),
+        })
+    }
+
+    fn analyse_part(
+        &mut self,
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        symmetric: bool,
+        entries: &[usize],
+    ) -> Result<(), LinearSolveError> {
+        assert!(entries.windows(2).all(|w| w[0] < w[1]), "ascending, once");
+        self.entries = entries.to_vec();
+        self.direct.analyse(n, col_ptr, row_idx, symmetric)
+    }
+
+    fn solve(
+        &mut self,
+        values: &[f64],
+        rhs: &mut [f64],
+    ) -> Result<Factorisation, LinearSolveError> {
+        self.whole.clear();
+        self.whole.resize(values.len(), 0.0);
+        for &e in &self.entries {
+            self.whole[e] = values[e];
+        }
+        self.ranks.all_reduce(&mut self.whole, Reduce::Sum).unwrap();
+        self.direct.solve(&self.whole, rhs)
+    }
+
+    fn last_factorisation(&self) -> Option<Factorisation> {
+        self.direct.last_factorisation()
+    }
+
+    fn nnz(&self) -> usize {
+        self.direct.nnz()
+    }
+
+    fn solves_over_ranks(&self) -> bool {
+        true
+    }
+}
+
+#[test]
+fn a_solver_over_ranks_given_each_ranks_own_entries_solves_the_same_system() {
+    for treatment in [Treatment::Standard, Treatment::FBar] {
+        for size in [2, 3] {
+            let replicated: Vec<Outcome> = on_threads(size, treatment, Deal::Cells)
+                .into_iter()
+                .map(Result::unwrap)
+                .collect();
+            let solvers = ThreadRanks::group(size);
+            let runs = ThreadRanks::group(size);
+            let together: Vec<Outcome> = std::thread::scope(|s| {
+                let handles: Vec<_> = runs
+                    .into_iter()
+                    .zip(solvers)
+                    .map(|(r, ranks)| {
+                        s.spawn(move || {
+                            let linear = Together {
+                                ranks,
+                                direct: FaerDirect::default(),
+                                entries: Vec::new(),
+                                whole: Vec::new(),
+                            };
+                            strip_load::on_ranks_with(
+                                Box::new(r),
+                                treatment,
+                                Deal::Cells,
+                                Box::new(linear),
+                            )
+                        })
+                    })
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| h.join().unwrap().unwrap())
+                    .collect()
+            });
+            assert_eq!(together, replicated, "{treatment:?} on {size} ranks");
+        }
     }
 }

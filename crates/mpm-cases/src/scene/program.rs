@@ -128,6 +128,7 @@ where
         // every step or output, by every rank.
         checkpoint: true,
         resume,
+        external_linear: mpm_distributed::external_linear(),
         ..RunControl::default()
     };
     let result = if explicit {

@@ -265,8 +265,12 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     /// or at the converged iterate when Newton expected to correct it,
     /// [`StepReport::unused_tangents`]), or `None` if the step converged
     /// without assembling one.
+    /// `None` too on ranks whose linear solver takes each rank's own
+    /// values ([`LinearSolver::solves_over_ranks`]): no rank holds the
+    /// whole stiffness.
     pub fn free_stiffness(&self) -> Option<FreeStiffness<'_>> {
-        self.it.stiffness_assembled.then(|| FreeStiffness {
+        let partial = self.ranks.is_some() && self.linear.solves_over_ranks();
+        (self.it.stiffness_assembled && !partial).then(|| FreeStiffness {
             n: self.system.n_free,
             col_ptr: &self.system.col_ptr,
             row_idx: &self.system.row_idx,

@@ -13,7 +13,11 @@
 //!   ranks' sums.
 //! - **Linear solve**: on rank 0 with the solver the options name, its
 //!   solution (or its failure) sent to every rank, so every rank holds the
-//!   same increment.
+//!   same increment; or, with a solver over ranks (PETSc's parallel
+//!   matrices, [`LinearSolver::solves_over_ranks`]), on every rank
+//!   together, each giving the entries of its own points
+//!   ([`RankLink::own_entries`]) unsummed: the stiffness is then never
+//!   replicated.
 //! - **Decisions**: the residual is reduced before the convergence test,
 //!   and every failure of a rank's points (a constitutive update, a basis
 //!   evaluation, the commit) is decided together ([`RankLink::agree_step`],
@@ -22,16 +26,16 @@
 //!
 //! One rank is the single solver bit for bit (no reduction changes a
 //! number). On N ranks only the order of the additions over points
-//! changes. What this replicates (the nodal vectors and the matrix values
-//! on every rank, one rank solving) suits a machine's worth of ranks, not
-//! hundreds; a linear solver that takes each rank's part of the matrix
-//! (PETSc's parallel AIJ) is the step after it (docs/src/guide/distributed.md).
+//! changes. What stays replicated (the nodal vectors on every rank, and
+//! without a solver over ranks the matrix values too, one rank solving)
+//! suits a machine's worth of ranks, not hundreds
+//! (docs/src/guide/distributed.md).
 
 use crate::error::{SolverError, StepFailure};
 use crate::linear::{LinearSolveError, LinearSolver};
 use crate::locking::PatchAssignment;
 use crate::ranks::{self, RankError, Ranks, Reduce};
-use crate::stages::system::{Candidates, NONE};
+use crate::stages::system::{Candidates, NONE, StepSystem};
 
 /// The implicit solver's link to the other ranks of a distributed run.
 pub(super) struct RankLink {
@@ -42,6 +46,10 @@ pub(super) struct RankLink {
     /// The problem's index of each of this rank's points, which failures
     /// name; empty: the local indices.
     ids: Vec<usize>,
+    /// This rank's own neighbour lists of the load step (CSR over the
+    /// active nodes), before [`RankLink::unite_neighbours`] united them.
+    own_ptr: Vec<usize>,
+    own: Vec<u32>,
 }
 
 impl std::fmt::Debug for RankLink {
@@ -68,23 +76,6 @@ pub(super) fn backtracks(f: &StepFailure) -> bool {
     )
 }
 
-/// What rank 0's linear solve ended with, as sent to the other ranks.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum SolveCode {
-    Solved = 0,
-    /// A failure a smaller increment may cure.
-    Failed = 1,
-    /// [`LinearSolveError::Configuration`]: fatal.
-    Misconfigured = 2,
-}
-
-impl SolveCode {
-    /// The code as the reduction carries it.
-    fn value(self) -> f64 {
-        f64::from(self as u8)
-    }
-}
-
 impl RankLink {
     /// A link through `ranks`.
     pub(super) fn new(ranks: Box<dyn Ranks>) -> Self {
@@ -92,6 +83,8 @@ impl RankLink {
             ranks,
             failure: None,
             ids: Vec::new(),
+            own_ptr: Vec::new(),
+            own: Vec::new(),
         }
     }
 
@@ -196,11 +189,12 @@ impl RankLink {
     /// The union over the ranks of the neighbour lists `nb_ptr`/`nb` (CSR
     /// over the active nodes): every rank sends its lists to every other
     /// one. `rebuild` receives a function that pushes node `w`'s
-    /// neighbours from every rank (the caller sorts and deduplicates).
+    /// neighbours from every rank (the caller sorts and deduplicates). The
+    /// rank's own lists are kept for [`RankLink::own_entries`].
     pub(super) fn unite_neighbours(
         &mut self,
-        nb_ptr: &[usize],
-        nb: &[u32],
+        nb_ptr: Vec<usize>,
+        nb: Vec<u32>,
         rebuild: &mut dyn FnMut(&Candidates<'_>),
     ) {
         let (me, size) = self.rank_and_size();
@@ -238,6 +232,8 @@ impl RankLink {
                 .chain(&received[w])
                 .for_each(|&v| push(v));
         });
+        self.own_ptr = nb_ptr;
+        self.own = nb;
     }
 
     /// Checks that no patch of a coupled locking treatment holds points
@@ -275,14 +271,17 @@ impl RankLink {
         }
     }
 
-    /// Solves on rank 0 and sends the solution, or the failure, to every
-    /// rank: on return `rhs` holds the same numbers on every rank.
+    /// Solves the system of the summed values (or, with a solver over
+    /// ranks, of every rank's own values: [`LinearSolver::solves_over_ranks`])
+    /// and decides the outcome together: on return `rhs` holds the same
+    /// solution on every rank. Without a solver over ranks, rank 0 solves
+    /// and sends its solution.
     ///
     /// # Errors
-    /// Rank 0's own error there; elsewhere a [`LinearSolveError::Backend`]
-    /// (or [`LinearSolveError::Configuration`] when rank 0's was one)
-    /// carrying its message.
-    pub(super) fn solve_on_root(
+    /// The lowest failing rank's own error there; elsewhere a
+    /// [`LinearSolveError::Backend`] (or [`LinearSolveError::Configuration`]
+    /// when that rank's was one) carrying its message.
+    pub(super) fn solve(
         &mut self,
         linear: &mut dyn LinearSolver,
         values: &[f64],
@@ -291,50 +290,70 @@ impl RankLink {
         if self.ranks.size() == 1 {
             return linear.solve(values, rhs).map(|_| ());
         }
-        let root = self.ranks.rank() == 0;
-        let mut local = Ok(());
-        let mut code = [SolveCode::Solved.value()];
-        if root {
-            local = linear.solve(values, rhs).map(|_| ());
-            if let Err(e) = &local {
-                rhs.fill(0.0);
-                code[0] = match e {
-                    LinearSolveError::Configuration { .. } => SolveCode::Misconfigured,
-                    _ => SolveCode::Failed,
-                }
-                .value();
-            }
+        let together = linear.solves_over_ranks();
+        let solves_here = together || self.ranks.rank() == 0;
+        let local = if solves_here {
+            linear.solve(values, rhs).map(|_| ())
         } else {
-            rhs.fill(0.0);
-        }
+            Ok(())
+        };
         let transport = |e: RankError| LinearSolveError::Backend {
             library: "rank transport",
             message: e.to_string(),
         };
-        self.ranks
-            .all_reduce(&mut code, Reduce::Max)
-            .map_err(transport)?;
-        if code[0] == SolveCode::Solved.value() {
-            // Zeros elsewhere: the sum is rank 0's solution exactly.
-            return self.ranks.all_reduce(rhs, Reduce::Sum).map_err(transport);
-        }
-        let mut text = match &local {
-            Err(e) => e.to_string(),
+        // The first character says whether the failure is fatal.
+        let describe = || match &local {
+            Err(e @ LinearSolveError::Configuration { .. }) => format!("c{e}"),
+            Err(e) => format!("f{e}"),
             Ok(()) => String::new(),
         };
-        self.ranks.broadcast_text(0, &mut text).map_err(transport)?;
-        match local {
-            Err(e) => Err(e),
-            Ok(()) if code[0] == SolveCode::Misconfigured.value() => {
-                Err(LinearSolveError::Configuration {
-                    library: "rank 0's linear solver",
-                    message: text,
+        match ranks::lowest_failure(self.ranks.as_ref(), local.is_err(), describe)
+            .map_err(transport)?
+        {
+            None if together => Ok(()),
+            None => {
+                if !solves_here {
+                    rhs.fill(0.0);
+                }
+                // Zeros elsewhere: the sum is rank 0's solution exactly.
+                self.ranks.all_reduce(rhs, Reduce::Sum).map_err(transport)
+            }
+            Some((rank, _)) if rank == self.ranks.rank() => local,
+            Some((_, text)) => {
+                let message = text.get(1..).unwrap_or_default().to_owned();
+                let library = "another rank's linear solver";
+                Err(if text.starts_with('c') {
+                    LinearSolveError::Configuration { library, message }
+                } else {
+                    LinearSolveError::Backend { library, message }
                 })
             }
-            Ok(()) => Err(LinearSolveError::Backend {
-                library: "rank 0's linear solver",
-                message: text,
-            }),
         }
+    }
+
+    /// The positions in the united pattern of `sys` of the entries this
+    /// rank's points add to (ascending): those of its own neighbour lists,
+    /// kept by [`RankLink::unite_neighbours`].
+    pub(super) fn own_entries<const D: usize>(&self, sys: &StepSystem<D>) -> Vec<usize> {
+        let (own_ptr, own) = (&self.own_ptr, &self.own);
+        let mut entries = Vec::with_capacity(own.len() * D * D);
+        for w in 0..own_ptr.len().saturating_sub(1) {
+            let all = &sys.nb[sys.nb_ptr[w]..sys.nb_ptr[w + 1]];
+            let blocks = &sys.block_map[sys.nb_ptr[w] * D * D..];
+            for &v in &own[own_ptr[w]..own_ptr[w + 1]] {
+                let Ok(pos) = all.binary_search(&v) else {
+                    continue;
+                };
+                let block = &blocks[pos * D * D..(pos + 1) * D * D];
+                entries.extend(
+                    block
+                        .iter()
+                        .filter(|&&at| at != NONE)
+                        .map(|&at| sys.block_ptr[w] + at as usize),
+                );
+            }
+        }
+        entries.sort_unstable();
+        entries
     }
 }

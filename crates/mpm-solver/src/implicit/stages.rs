@@ -187,6 +187,15 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         }
     }
 
+    /// Replaces the stiffness `values` by their sum over the ranks, unless
+    /// the linear solver takes each rank's own
+    /// ([`LinearSolver::solves_over_ranks`]).
+    fn sum_stiffness_over_ranks(&mut self, values: &mut [f64]) {
+        if !self.linear.solves_over_ranks() {
+            Self::sum_over_ranks(&mut self.ranks, values);
+        }
+    }
+
     /// The rounding-noise level of the residual from the last tangent
     /// pass's norms ([`convergence::rounding_noise`]), its node bounds
     /// summed over the ranks.
@@ -235,9 +244,17 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let symmetric =
             <P::Law as LogStrainLaw>::SYMMETRIC_TANGENT && !self.locking.couples_points();
         self.analysed = false;
-        self.linear
-            .analyse(sys.n_free, &sys.col_ptr, &sys.row_idx, symmetric)
-            .map_err(SolverError::Pattern)?;
+        match &self.ranks {
+            Some(link) if self.linear.solves_over_ranks() => {
+                let own = link.own_entries(sys);
+                let (n, ptr, idx) = (sys.n_free, &sys.col_ptr, &sys.row_idx);
+                self.linear.analyse_part(n, ptr, idx, symmetric, &own)
+            }
+            _ => self
+                .linear
+                .analyse(sys.n_free, &sys.col_ptr, &sys.row_idx, symmetric),
+        }
+        .map_err(SolverError::Pattern)?;
         if self.linear.wants_rigid_body_modes() {
             let mesh = &self.mesh;
             let free: Vec<_> = (0..sys.n_active() * D)
@@ -338,7 +355,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let sys = &mut self.system;
         if let Some(link) = &mut self.ranks {
             let (nb_ptr, nb) = (std::mem::take(&mut sys.nb_ptr), std::mem::take(&mut sys.nb));
-            link.unite_neighbours(&nb_ptr, &nb, &mut |all| sys.build_neighbours_from(all));
+            link.unite_neighbours(nb_ptr, nb, &mut |all| sys.build_neighbours_from(all));
         }
         let ghost = &self.ghost;
         if !ghost.is_empty() {
@@ -832,7 +849,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         if !self.ghost.is_empty() {
             self.ghost.add_stiffness(&self.system, &mut values);
         }
-        Self::sum_over_ranks(&mut self.ranks, &mut values);
+        self.sum_stiffness_over_ranks(&mut values);
         self.it.values = values;
         self.it.stiffness_assembled = true;
     }
@@ -862,7 +879,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             self.ghost.add_stiffness(&self.system, &mut values);
         }
         Self::sum_over_ranks(&mut self.ranks, &mut f_int);
-        Self::sum_over_ranks(&mut self.ranks, &mut values);
+        self.sum_stiffness_over_ranks(&mut values);
         self.it.f_int = f_int;
         self.it.values = values;
         self.it.stiffness_assembled = true;
@@ -884,7 +901,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             }
         }
         match &mut self.ranks {
-            Some(link) => link.solve_on_root(self.linear.as_mut(), &it.values, &mut it.rhs)?,
+            Some(link) => link.solve(self.linear.as_mut(), &it.values, &mut it.rhs)?,
             None => {
                 self.linear.solve(&it.values, &mut it.rhs)?;
             }

@@ -225,6 +225,38 @@ pub trait LinearSolver: Send + std::fmt::Debug {
         false
     }
 
+    /// Whether this solver is one solver over all the ranks of a
+    /// distributed run (PETSc's parallel matrices over MPI processes):
+    /// then every rank calls [`LinearSolver::analyse_part`] and
+    /// [`LinearSolver::solve`] together, each with the values of its own
+    /// points only, instead of one rank solving the summed system.
+    /// Default: no.
+    fn solves_over_ranks(&self) -> bool {
+        false
+    }
+
+    /// [`LinearSolver::analyse`] for a solver over ranks: the pattern is
+    /// the whole system's, the same on every rank, and `entries` (ascending
+    /// positions in it) are those this rank's points add to. The values
+    /// [`LinearSolver::solve`] then receives are this rank's sums, read at
+    /// `entries` only; its right-hand side is the whole one, the same on
+    /// every rank, and so is the solution it leaves there. Default:
+    /// [`LinearSolver::analyse`] (a solver of the whole system).
+    ///
+    /// # Errors
+    /// As [`LinearSolver::analyse`].
+    fn analyse_part(
+        &mut self,
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        symmetric: bool,
+        entries: &[usize],
+    ) -> Result<(), LinearSolveError> {
+        let _ = entries;
+        self.analyse(n, col_ptr, row_idx, symmetric)
+    }
+
     /// The orthonormal rigid-body modes of the free dofs of the pattern
     /// just analysed ([`rigid_body_modes`]), for a multigrid
     /// preconditioner's near-null space. Default: ignored.

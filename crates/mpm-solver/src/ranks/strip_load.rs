@@ -22,6 +22,7 @@ use crate::domain::NoUpdate;
 use crate::error::SolverError;
 use crate::formulation::UpdatedLagrangian;
 use crate::implicit::{ImplicitSolver, NewtonOptions};
+use crate::linear::LinearSolver;
 use crate::locking::{FBar, LockingTreatment, NoLocking};
 use crate::parts::Parts;
 use crate::points::MaterialPoints;
@@ -84,7 +85,7 @@ pub fn initial_position(id: usize) -> Vector2<f64> {
 /// # Errors
 /// The solver's.
 pub fn single(treatment: Treatment) -> Result<Outcome, SolverError> {
-    run(treatment, None, Deal::Cells)
+    run(treatment, None, Deal::Cells, None)
 }
 
 /// This rank's part of the problem on `ranks`, the points dealt as `deal`
@@ -97,17 +98,33 @@ pub fn on_ranks(
     treatment: Treatment,
     deal: Deal,
 ) -> Result<Outcome, SolverError> {
-    run(treatment, Some(ranks), deal)
+    run(treatment, Some(ranks), deal, None)
+}
+
+/// [`on_ranks`] with the linear solver `linear` (e.g. one over all
+/// ranks, [`LinearSolver::solves_over_ranks`]) instead of the default
+/// options'.
+///
+/// # Errors
+/// The solver's, decided over the ranks.
+pub fn on_ranks_with(
+    ranks: Box<dyn Ranks>,
+    treatment: Treatment,
+    deal: Deal,
+    linear: Box<dyn LinearSolver>,
+) -> Result<Outcome, SolverError> {
+    run(treatment, Some(ranks), deal, Some(linear))
 }
 
 fn run(
     treatment: Treatment,
     ranks: Option<Box<dyn Ranks>>,
     deal: Deal,
+    linear: Option<Box<dyn LinearSolver>>,
 ) -> Result<Outcome, SolverError> {
     match treatment {
-        Treatment::Standard => solve(NoLocking, ranks, deal),
-        Treatment::FBar => solve(FBar::default(), ranks, deal),
+        Treatment::Standard => solve(NoLocking, ranks, deal, linear),
+        Treatment::FBar => solve(FBar::default(), ranks, deal, linear),
     }
 }
 
@@ -149,7 +166,12 @@ fn supports(grid: &RegularGrid<2>) -> Result<NodalConstraints<2>, SolverError> {
     Ok(c)
 }
 
-fn solve<K>(locking: K, ranks: Option<Box<dyn Ranks>>, deal: Deal) -> Result<Outcome, SolverError>
+fn solve<K>(
+    locking: K,
+    ranks: Option<Box<dyn Ranks>>,
+    deal: Deal,
+    linear: Option<Box<dyn LinearSolver>>,
+) -> Result<Outcome, SolverError>
 where
     K: LockingTreatment<2, RegularGrid<2>>,
 {
@@ -185,6 +207,9 @@ where
     if let Some(r) = ranks {
         solver.on_ranks(r);
         solver.name_points(ids.clone());
+    }
+    if let Some(linear) = linear {
+        solver.set_linear_solver(linear);
     }
     let (mut residuals, mut reactions) = (Vec::new(), Vec::new());
     solver.run(
