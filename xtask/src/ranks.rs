@@ -155,7 +155,7 @@ pub fn run(quick: bool, root: &Path, docs: &Path) -> Result<()> {
     write_case(&mut page, &petsc_name, &petsc_set, &petsc)?;
     writeln!(
         page,
-        "With the built-in linear solver, rank 0 solves the whole (summed) system alone on 2 processes (`solve`), so only the per-point stages divide. With PETSc each process hands it the entries of its own points and the Krylov method and GAMG run over both processes; on 1 process PETSc runs single-threaded whatever the thread count. `other` is the wall time outside the named stages: in the explicit run on 2 processes the halo exchange, the migration, the counts for the balance and the reductions.\n"
+        "With the built-in linear solver, rank 0 solves the whole (summed) system alone on 2 processes (`solve`), so only the per-point stages divide. With PETSc each process hands it the entries of its own points and the Krylov method and GAMG run over both processes (PETSc's own work is not threaded; on 1 process × 2 threads only our stages use the second core). `other` is the wall time outside the named stages: in the explicit run on 2 processes the halo exchange, the migration, the counts for the balance and the reductions.\n"
     )?;
     let page = machine::stamp_duration(page, start);
     let path = docs.join("benchmarks/ranks_scenes.md");
