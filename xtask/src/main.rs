@@ -58,6 +58,7 @@ mod plot;
 mod ranks;
 mod reference_values;
 mod report;
+mod scaling;
 mod scene_run;
 mod stability;
 mod structure;
@@ -126,6 +127,17 @@ tasks:
                 F-patch notched plate, solver time per stage, repeated and
                 interleaved; builds mpm with --features mpi, needs Open MPI; writes
                 docs/src/benchmarks/ranks_scenes.md (about 3 min; --quick: small)
+  scaling [--quick]
+                weak scaling at N = 1, 2, 4 processes (fixed points per rank): the
+                explicit column's per-rank work, halo and migration traffic and
+                collectives, the F-patch footing's Krylov iterations with PETSc, and
+                an α–β model of the explicit step at 16, 64, 256 ranks; writes
+                docs/src/benchmarks/scaling.md (builds mpm with --features mpi,petsc)
+  scaling --strong [--max-ranks N] [--quick]
+                the strong-scaling plan of Wang et al. (2021) Fig. 23: plate, footing
+                and full vane with F-patch at 1, 4, 11 points per element on 1, 2, 4,
+                ... N processes (default 16), PETSc over them; writes
+                docs/src/benchmarks/strong_scaling.md (--quick: the plate, small)
   structure [--deny]
                 functions over 150 lines and import circles between files in every
                 crate's src/ (tests left out); --deny fails on any
@@ -158,6 +170,7 @@ fn main() -> Result<()> {
             let quick = flag(&args[1..], "--quick")?;
             ranks::run(quick, &workspace_dir(), &docs_dir())
         }
+        Some("scaling") => scaling_command(&args[1..]),
         Some("structure") => {
             let deny = flag(&args[1..], "--deny")?;
             structure::run(&workspace_dir(), deny)
@@ -236,4 +249,30 @@ fn write_file(path: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     std::fs::write(path, contents).with_context(|| format!("writing {}", path.display()))
+}
+
+/// `scaling [--strong] [--max-ranks N] [--quick]`.
+fn scaling_command(args: &[String]) -> Result<()> {
+    let (mut strong, mut quick, mut max_ranks) = (false, false, 16);
+    let mut rest = args.iter();
+    while let Some(a) = rest.next() {
+        match a.as_str() {
+            "--strong" => strong = true,
+            "--quick" => quick = true,
+            "--max-ranks" => {
+                let n = rest.next().context("--max-ranks needs a number")?;
+                max_ranks = n
+                    .parse()
+                    .with_context(|| format!("--max-ranks {n}: not a number"))?;
+            }
+            other => {
+                bail!("unexpected argument `{other}` (expected --strong, --max-ranks N or --quick)")
+            }
+        }
+    }
+    if strong {
+        scaling::strong(max_ranks, quick, &workspace_dir(), &docs_dir())
+    } else {
+        scaling::weak(quick, &workspace_dir(), &docs_dir())
+    }
 }

@@ -90,9 +90,10 @@ fn main() {
     #[cfg(not(feature = "mpi"))]
     let ranks = None;
     if let Err(e) = run_cli(Cli::parse(), ranks.clone()) {
+        let text = describe(&e);
         let message = match &ranks {
-            Some(r) => format!("error (rank {} of {}): {e:#}\n", r.0.rank(), r.0.size()),
-            None => format!("error: {e:#}\n"),
+            Some(r) => format!("error (rank {} of {}): {text}\n", r.0.rank(), r.0.size()),
+            None => format!("error: {text}\n"),
         };
         // One write, not one per formatted piece (stderr is unbuffered):
         // the processes of a job share mpirun's stderr, and pieces of their
@@ -107,6 +108,20 @@ fn main() {
         // the others; mpirun ends the job.
         std::process::exit(1);
     }
+}
+
+/// `e` and its causes, each cause left out when the text before already
+/// says it (most of our errors print their source in their own message).
+fn describe(e: &anyhow::Error) -> String {
+    let mut text = e.to_string();
+    for cause in e.chain().skip(1) {
+        let cause = cause.to_string();
+        if !text.contains(&cause) {
+            text.push_str(": ");
+            text.push_str(&cause);
+        }
+    }
+    text
 }
 
 /// An error every process of a job reaches from the same input (the
@@ -127,7 +142,9 @@ impl std::error::Error for EveryProcess {}
 #[cfg(feature = "mpi")]
 fn processes(mpi: &mpm_cases::distributed::mpi_ranks::Mpi) -> Option<SharedRanks> {
     let ranks = mpi.ranks();
-    (ranks.size() > 1).then(|| SharedRanks(std::sync::Arc::new(ranks)))
+    // Counted: an explicit run's summary reports each rank's traffic.
+    let counted = mpm_solver::ranks::Counted::new(ranks);
+    (counted.size() > 1).then(|| SharedRanks(std::sync::Arc::new(counted)))
 }
 
 fn run_cli(cli: Cli, ranks: Option<SharedRanks>) -> Result<()> {

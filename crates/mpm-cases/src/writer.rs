@@ -139,6 +139,12 @@ pub struct ExplicitSummary<P: Serialize> {
     /// there was none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub rebalances: Vec<serde_json::Value>,
+    /// A run on several ranks: per rank the largest and the mean over the
+    /// ranks of this session's point work and grid seconds, halo and
+    /// migration messages and bytes, collectives and points migrated
+    /// (`mpm_dispatch::explicit::RanksReport`); absent on one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ranks: Option<serde_json::Value>,
     /// Scene results (bodies, probes, the PNG).
     #[serde(flatten)]
     pub results: serde_json::Map<String, serde_json::Value>,

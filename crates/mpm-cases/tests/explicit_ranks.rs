@@ -318,3 +318,40 @@ fn the_balance_keys_are_checked_at_the_key() {
         "{e}"
     );
 }
+
+/// What each rank sent, counted ([`mpm_solver::ranks::Counted`]) and
+/// reported with the run's output: on 2 ranks each has one neighbour, so
+/// every step makes exactly one message each way of the halo exchange
+/// (reverse and forward) and one of the migration; the points sent in
+/// the migrations and the new deals are what the ranks report, and the
+/// points are all there at the end.
+#[test]
+fn the_ranks_report_what_they_sent() {
+    let short = [
+        "solver.rebalance_threshold=1.02".to_owned(),
+        "solver.end_time=0.3".to_owned(),
+        "solver.output_interval=0.3".to_owned(),
+    ];
+    let (scene, source) = scene::parse(COLLAPSE, "explicit_collapse.toml", &short).unwrap();
+    let problem = Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap();
+    let outputs = ThreadRanks::run(2, |ranks| {
+        let counted = std::sync::Arc::new(mpm_solver::ranks::Counted::new(ranks));
+        let run = mpm_cases::scene::ranks::rank_run(&problem, counted).unwrap();
+        let control = RunControl {
+            ranks: Some(run),
+            ..RunControl::default()
+        };
+        scene::run_explicit(&problem, &control, |_| Ok(())).unwrap()
+    });
+    for out in &outputs {
+        let r = out.ranks.unwrap();
+        let steps = out.steps as f64;
+        eprintln!("{steps} steps: {r:?}");
+        assert_eq!(r.ranks, 2);
+        assert_eq!(r.halo_messages, [2.0 * steps; 2], "two per step each");
+        assert!(r.migration_messages[0] >= steps, "one per step at least");
+        assert!(r.halo_bytes[0] > 0.0 && r.collectives[0] >= steps);
+        assert!(r.migrated_points[1] > 0.0, "points cross between ranks");
+        assert_eq!(r, outputs[0].ranks.unwrap(), "the same report everywhere");
+    }
+}

@@ -81,6 +81,7 @@ use mpm_scene::rules::Context;
 use mpm_scene::variant::{LockingKind, VariantVisitor, dispatch_in};
 
 use crate::explicit_law::{ExplicitLaw, ExplicitLaws};
+pub use crate::explicit_ranks::RanksReport;
 pub use crate::explicit_ranks::Rebalanced;
 use crate::explicit_ranks::{self, Spread};
 use mpm_scene::build::{ExplicitSetup, Problem, SceneMesh};
@@ -150,6 +151,8 @@ pub struct ExplicitOutput {
     pub wall_time_s: f64,
     /// Wall time per stage of this session's steps.
     pub stage_times: ExplicitStageTimes,
+    /// On several ranks, what each sent and did in this session.
+    pub ranks: Option<RanksReport>,
 }
 
 /// A scene problem whose explicit run is compiled here: implemented for
@@ -599,7 +602,7 @@ fn time_loop<const D: usize>(
         // As `ExplicitSolver::run_until`, with the curves' forces set at
         // the start of every step.
         while run.time() < target * (1.0 - 1e-12) {
-            let info = run.step(setup, target - run.time())?;
+            let info = out.step(|| run.step(setup, target - run.time()))?;
             let balanced = out.after_step(run, info.step)?;
             wall.observe(|| out.show(ExplicitEvent::Step(info)))?;
             if let Some(b) = balanced {
@@ -617,6 +620,9 @@ fn time_loop<const D: usize>(
         grid: stage.grid - session_start.grid,
         g2p: stage.g2p - session_start.g2p,
     };
+    if let Some(spread) = &out.spread {
+        result.ranks = Some(spread.report(&result.stage_times)?);
+    }
     Ok(result)
 }
 
@@ -671,6 +677,14 @@ struct Outputs<'a, 'o, const D: usize> {
 }
 
 impl<const D: usize> Outputs<'_, '_, D> {
+    /// Runs `step`; on several ranks its traffic counted.
+    fn step<T>(&mut self, step: impl FnOnce() -> T) -> T {
+        match &mut self.spread {
+            Some(spread) => spread.step(step),
+            None => step(),
+        }
+    }
+
     /// On several ranks, after a step: the migration, and a new deal when
     /// the work has drifted out of balance.
     fn after_step(
@@ -812,6 +826,7 @@ fn summary<const D: usize>(
         energy_drift: if scale > 0.0 { drift / scale } else { 0.0 },
         wall_time_s: 0.0,
         stage_times: ExplicitStageTimes::default(),
+        ranks: None,
     }
 }
 

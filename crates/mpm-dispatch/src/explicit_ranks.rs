@@ -45,6 +45,34 @@ pub struct Rebalanced {
     pub moved: usize,
 }
 
+/// What the ranks of a run sent and did, per rank: the largest over the
+/// ranks and their mean (`[max, mean]`), from this session's steps. The
+/// traffic is counted when the ranks are ([`ranks::Counted`]; zero
+/// otherwise).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RanksReport {
+    /// The number of ranks.
+    pub ranks: usize,
+    /// Seconds of point work (point to grid and grid to point).
+    pub point_seconds: [f64; 2],
+    /// Seconds of the grid stage (the halo exchange included).
+    pub grid_seconds: [f64; 2],
+    /// Point-to-point messages of the steps: the halo exchanges, one per
+    /// neighbour each way per step (the outputs' gathers not counted).
+    pub halo_messages: [f64; 2],
+    /// Bytes those messages carried.
+    pub halo_bytes: [f64; 2],
+    /// Messages of the migrations (and new deals).
+    pub migration_messages: [f64; 2],
+    /// Bytes those carried.
+    pub migration_bytes: [f64; 2],
+    /// Collectives joined in the steps, migrations and new deals
+    /// (reductions, error broadcasts; the outputs' not counted).
+    pub collectives: [f64; 2],
+    /// Points sent to another rank after a step or by a new deal.
+    pub migrated_points: [f64; 2],
+}
+
 /// What a run on several ranks does not do yet.
 ///
 /// # Errors
@@ -117,6 +145,12 @@ pub(crate) struct Spread<'a> {
     nodes: usize,
     reach: usize,
     rank_of_cell: Vec<usize>,
+    /// This session's traffic of the steps (the halo exchanges and the
+    /// step's reductions), of the migrations and new deals, and the points
+    /// this rank sent in them; the outputs' gathers are in neither.
+    stepping: ranks::Traffic,
+    migration: ranks::Traffic,
+    migrated: usize,
 }
 
 impl<'a> Spread<'a> {
@@ -150,6 +184,62 @@ impl<'a> Spread<'a> {
             nodes: grid.node_count(),
             reach,
             rank_of_cell: run.rank_of_cell.clone(),
+            stepping: ranks::Traffic::default(),
+            migration: ranks::Traffic::default(),
+            migrated: 0,
+        })
+    }
+
+    /// Runs `step`, counting its traffic as the steps'.
+    pub(crate) fn step<T>(&mut self, step: impl FnOnce() -> T) -> T {
+        let counted = self.traffic();
+        let result = step();
+        self.stepping = self.stepping.plus(self.traffic().since(counted));
+        result
+    }
+
+    /// The traffic so far (zero when not counted).
+    fn traffic(&self) -> ranks::Traffic {
+        self.run.ranks.traffic().unwrap_or_default()
+    }
+
+    /// What every rank sent and did in this session, `times` this rank's
+    /// stage times of it. Collective.
+    ///
+    /// # Errors
+    /// The transport's.
+    pub(crate) fn report(
+        &self,
+        times: &mpm_solver::explicit::ExplicitStageTimes,
+    ) -> Result<RanksReport, SolverError> {
+        let (halo, migration) = (self.stepping, self.migration);
+        let bytes = |t: ranks::Traffic| 8.0 * t.values as f64;
+        let mine = [
+            times.p2g + times.g2p,
+            times.grid,
+            halo.messages as f64,
+            bytes(halo),
+            migration.messages as f64,
+            bytes(migration),
+            (halo.collectives + migration.collectives) as f64,
+            self.migrated as f64,
+        ];
+        let mut max = mine;
+        let mut sum = mine;
+        self.run.ranks.all_reduce(&mut max, Reduce::Max)?;
+        self.run.ranks.all_reduce(&mut sum, Reduce::Sum)?;
+        let size = self.run.ranks.size();
+        let pair = |k: usize| [max[k], sum[k] / size as f64];
+        Ok(RanksReport {
+            ranks: size,
+            point_seconds: pair(0),
+            grid_seconds: pair(1),
+            halo_messages: pair(2),
+            halo_bytes: pair(3),
+            migration_messages: pair(4),
+            migration_bytes: pair(5),
+            collectives: pair(6),
+            migrated_points: pair(7),
         })
     }
 
@@ -196,7 +286,10 @@ impl<'a> Spread<'a> {
         run: &mut dyn Stepper<D>,
         step: usize,
     ) -> Result<Option<Rebalanced>, SolverError> {
-        run.migrate()?;
+        let counted = self.traffic();
+        let (sent, _) = run.migrate()?;
+        self.migrated += sent;
+        self.migration = self.migration.plus(self.traffic().since(counted));
         let Some(balance) = &self.run.balance else {
             return Ok(None);
         };
@@ -215,7 +308,10 @@ impl<'a> Spread<'a> {
         if after >= before {
             return Ok(None);
         }
+        let counted = self.traffic();
         let (sent, _) = run.rebalance(self.layout(cells.clone())?)?;
+        self.migrated += sent;
+        self.migration = self.migration.plus(self.traffic().since(counted));
         self.rank_of_cell = cells;
         let mut moved = [sent as f64];
         self.run.ranks.all_reduce(&mut moved, Reduce::Sum)?;

@@ -366,6 +366,23 @@ impl Matrix {
         }
     }
 
+    /// $\|b - A x\|_2$, the true (unpreconditioned) residual norm of `x`.
+    ///
+    /// # Errors
+    /// PETSc failed.
+    pub fn residual_norm(&self, s: &Session, b: &Vector, x: &Vector) -> Result<f64, PetscError> {
+        let r = self.vector(s)?;
+        let mut norm = 0.0;
+        // SAFETY: live matrix and vectors of its layout; `r` is destroyed
+        // when dropped.
+        unsafe {
+            check(ffi::MatMult(self.0, x.0, r.0), "MatMult")?;
+            check(ffi::VecAYPX(r.0, -1.0, b.0), "VecAYPX")?;
+            check(ffi::VecNorm(r.0, ffi::NORM_2, &mut norm), "VecNorm")?;
+        }
+        Ok(norm)
+    }
+
     /// A vector with the matrix's row layout.
     ///
     /// # Errors

@@ -257,9 +257,13 @@ impl LinearSolver for PetscLinear {
         }
         self.iterations = outcome.iterations;
         if outcome.reason == DIVERGED_ITS {
+            // PETSc's own residual norm is the preconditioned one for
+            // left-preconditioned methods (GMRES by default): the ratio
+            // to |b| reported is the true residual's.
+            let residual = step.matrix.residual_norm(&s, &step.b, &step.x)?;
             return Err(LinearSolveError::NotConverged {
                 iterations: outcome.iterations,
-                relative_residual: outcome.residual_norm / b_norm.max(f64::MIN_POSITIVE),
+                relative_residual: residual / b_norm.max(f64::MIN_POSITIVE),
             });
         }
         if outcome.reason < 0 {

@@ -450,8 +450,26 @@ where
         final_energies: energies_json(&r.last_energies),
         energy_drift: r.energy_drift,
         rebalances,
+        ranks: r.ranks.as_ref().map(ranks_json),
         results,
         parameters: scene,
     };
     obs.finish_explicit(summary)
+}
+
+/// A run's [`mpm_dispatch::explicit::RanksReport`] as `summary.json` holds
+/// it: each measure as `{ "max": ..., "mean": ... }` over the ranks.
+fn ranks_json(r: &mpm_dispatch::explicit::RanksReport) -> Value {
+    let pair = |p: [f64; 2]| json!({ "max": p[0], "mean": p[1] });
+    json!({
+        "ranks": r.ranks,
+        "point_seconds": pair(r.point_seconds),
+        "grid_seconds": pair(r.grid_seconds),
+        "halo_messages": pair(r.halo_messages),
+        "halo_bytes": pair(r.halo_bytes),
+        "migration_messages": pair(r.migration_messages),
+        "migration_bytes": pair(r.migration_bytes),
+        "collectives": pair(r.collectives),
+        "migrated_points": pair(r.migrated_points),
+    })
 }

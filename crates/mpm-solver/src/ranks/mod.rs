@@ -12,6 +12,7 @@
 //!   stops at the same step with the same error.
 //! - [`ThreadRanks`]: N ranks as threads of one process, so the default
 //!   test suite checks that one rank equals N ranks without MPI.
+//! - [`Counted`]: any ranks with their traffic counted ([`Traffic`]).
 //!
 //! The mesh is replicated; a rank allocates the grid arrays of the whole
 //! mesh but touches only the nodes near its points.
@@ -20,8 +21,10 @@ pub mod disks;
 pub mod halo;
 pub mod strip_load;
 mod threads;
+mod traffic;
 
 pub use threads::ThreadRanks;
+pub use traffic::{Counted, Traffic};
 
 use thiserror::Error;
 
@@ -105,6 +108,12 @@ pub trait Ranks: Send + Sync {
     /// # Errors
     /// The transport failed.
     fn broadcast_text(&self, root: usize, text: &mut String) -> Result<(), RankError>;
+
+    /// What this rank has sent so far, when counted ([`Counted`]); `None`
+    /// otherwise.
+    fn traffic(&self) -> Option<Traffic> {
+        None
+    }
 }
 
 /// Shared ranks are ranks: a run that keeps its communication (e.g. for
@@ -133,6 +142,10 @@ impl<R: Ranks + ?Sized> Ranks for std::sync::Arc<R> {
 
     fn broadcast_text(&self, root: usize, text: &mut String) -> Result<(), RankError> {
         (**self).broadcast_text(root, text)
+    }
+
+    fn traffic(&self) -> Option<Traffic> {
+        (**self).traffic()
     }
 }
 
