@@ -16,6 +16,7 @@ use crate::output::{
 };
 use crate::run::Snapshot;
 use crate::variant::Variant;
+use mpm_dispatch::on_ranks::PieceFields;
 
 pub use mpm_scene::format::Field;
 
@@ -31,6 +32,9 @@ pub struct RunWriter<const D: usize, M> {
     iterations: CsvTable,
     tables: BTreeMap<String, CsvTable>,
     options: VtuOptions,
+    /// The ranks writing their own pieces of the points' files (0 or 1:
+    /// this writer writes them whole).
+    pieces: usize,
 }
 
 /// What the VTU files of a run hold and how often they are written.
@@ -192,12 +196,19 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
             iterations: CsvTable::new(&["step", "iteration", "normalised_residual"])?,
             tables: BTreeMap::new(),
             options: VtuOptions::default(),
+            pieces: 0,
         })
     }
 
     /// Sets what the VTU files hold and how often they are written.
     pub fn set_vtu_options(&mut self, options: VtuOptions) {
         self.options = options;
+    }
+
+    /// Writes the points' files as the parallel master of the pieces that
+    /// `ranks` ranks write ([`write_piece`]).
+    pub fn set_pieces(&mut self, ranks: usize) {
+        self.pieces = ranks;
     }
 
     /// A writer that continues the series and tables of `state` (a resumed
@@ -218,6 +229,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
             iterations: state.iterations,
             tables: state.tables,
             options: VtuOptions::default(),
+            pieces: 0,
         })
     }
 
@@ -266,8 +278,7 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
                 .set_nodes(nodes)
                 .map_err(|source| CasesError::Mesh { source })?;
         }
-        let last = report.lambda1 >= 1.0 - 1e-12;
-        if (step + 1).is_multiple_of(self.options.every.max(1)) || last {
+        if writes_vtu(self.options.every, step, report.lambda1) {
             self.write_vtu(step, report.lambda1, snap)?;
         }
         let mut row = vec![
@@ -320,45 +331,33 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
 
     /// The VTU files (points and active grid) and the tangent of one step,
     /// at `time` in the series (the load factor, or the simulated time).
+    /// On several ranks that write their own pieces ([`Self::set_pieces`])
+    /// the points' file is the parallel master `points_NNNN.pvtu` of the
+    /// pieces `points_NNNN_K.vtu`, each written by rank K
+    /// ([`write_piece`]).
     fn write_vtu(&mut self, step: usize, time: f64, snap: &Snapshot) -> Result<(), CasesError> {
-        let name = format!("points_{step:04}.vtu");
-        let path = self.dir.join(&name);
-        let mut vtu = UnstructuredGrid::new(&snap.position)?;
-        vtu.add_vertex_cells();
-        let has = |f: Field| self.options.fields.contains(&f);
-        if has(Field::Displacement) {
-            vtu.point_data("displacement", Values::vectors(&snap.displacement))?;
-        }
-        if has(Field::Velocity) && !snap.velocity.is_empty() {
-            vtu.point_data("velocity", Values::vectors(&snap.velocity))?;
-        }
-        if has(Field::Stress) {
-            vtu.point_data("cauchy_stress", Values::tensors(&snap.sigma))?;
-        }
-        if has(Field::DeformationGradient) {
-            vtu.point_data("deformation_gradient", Values::tensors(&snap.f))?;
-        }
-        if has(Field::Volume) {
-            vtu.point_data("volume", Values::scalars(&snap.volume))?;
-        }
-        if has(Field::PlasticStrain) {
-            vtu.point_data(
-                "equivalent_plastic_strain",
-                Values::scalars(&snap.plastic_strain),
-            )?;
-        }
-        let (lower, upper): (Vec<[f64; 3]>, Vec<[f64; 3]>) =
-            snap.domain_bounds.iter().copied().unzip();
-        if !lower.is_empty() && has(Field::Domain) {
-            vtu.point_data("domain_lower", Values::vectors(&lower))?;
-            vtu.point_data("domain_upper", Values::vectors(&upper))?;
-        }
-        if has(Field::Body) {
-            for (name, values) in &self.options.constants {
-                vtu.point_data(name, Values::scalars(values))?;
-            }
-        }
-        vtu.write(&path)?;
+        let bounds = snap.domain_bounds.iter().copied().unzip();
+        let fields = PieceFields {
+            velocity: !snap.velocity.is_empty(),
+            domains: !snap.domain_bounds.is_empty(),
+        };
+        let vtu = points_grid(
+            &self.options,
+            snap,
+            fields,
+            &self.options.constants,
+            &bounds,
+        )?;
+        let path = if self.pieces > 1 {
+            let path = self.dir.join(format!("points_{step:04}.pvtu"));
+            let pieces: Vec<String> = (0..self.pieces).map(|k| piece_name(step, k)).collect();
+            vtu.write_parallel(&path, &pieces)?;
+            path
+        } else {
+            let path = self.dir.join(format!("points_{step:04}.vtu"));
+            vtu.write(&path)?;
+            path
+        };
         self.points.push(time, &path)?;
 
         if let Some(k) = &snap.tangent {
@@ -391,4 +390,94 @@ impl<const D: usize, M: CellMesh<D>> RunWriter<D, M> {
     ) -> Result<(), CasesError> {
         Ok(write_summary(&self.dir.join("summary.json"), summary)?)
     }
+}
+
+/// Whether an implicit run writes the VTU files of step `step`, which
+/// reached `load_factor`: every `every` steps and the step that reaches 1.
+pub fn writes_vtu(every: usize, step: usize, load_factor: f64) -> bool {
+    (step + 1).is_multiple_of(every.max(1)) || load_factor >= 1.0 - 1e-12
+}
+
+/// The file name of rank `rank`'s piece of output `index`.
+fn piece_name(index: usize, rank: usize) -> String {
+    format!("points_{index:04}_{rank}.vtu")
+}
+
+/// Writes rank `rank`'s piece `points_NNNN_K.vtu` of output `index` into
+/// `dir`: its own points `snap`, whose indices in the problem are `ids`,
+/// with the fields of `options` (the per-point constants taken at `ids`).
+/// Rank 0 writes the master that names every rank's piece
+/// ([`RunWriter::set_pieces`]).
+///
+/// # Errors
+/// Output errors (a non-finite value, the file not written).
+pub fn write_piece(
+    dir: &Path,
+    options: &VtuOptions,
+    (index, rank): (usize, usize),
+    snap: &Snapshot,
+    ids: &[usize],
+    fields: PieceFields,
+) -> Result<(), CasesError> {
+    let constants: Vec<(String, Vec<f64>)> = options
+        .constants
+        .iter()
+        .map(|(name, values)| {
+            let mine = ids
+                .iter()
+                .map(|&id| values.get(id).copied().unwrap_or(f64::NAN));
+            (name.clone(), mine.collect())
+        })
+        .collect();
+    let bounds = snap.domain_bounds.iter().copied().unzip();
+    let vtu = points_grid(options, snap, fields, &constants, &bounds)?;
+    Ok(vtu.write(&dir.join(piece_name(index, rank)))?)
+}
+
+/// The material points of `snap` as vertices with the fields of
+/// `options` (velocities and domains where `present` says): `constants`
+/// one value per point of `snap`, `bounds` its domains' lower and upper
+/// corners.
+fn points_grid<'s>(
+    options: &VtuOptions,
+    snap: &'s Snapshot,
+    present: PieceFields,
+    constants: &'s [(String, Vec<f64>)],
+    bounds: &'s (Vec<[f64; 3]>, Vec<[f64; 3]>),
+) -> Result<UnstructuredGrid<'s>, CasesError> {
+    let mut vtu = UnstructuredGrid::new(&snap.position)?;
+    vtu.add_vertex_cells();
+    let has = |f: Field| options.fields.contains(&f);
+    if has(Field::Displacement) {
+        vtu.point_data("displacement", Values::vectors(&snap.displacement))?;
+    }
+    if has(Field::Velocity) && present.velocity {
+        vtu.point_data("velocity", Values::vectors(&snap.velocity))?;
+    }
+    if has(Field::Stress) {
+        vtu.point_data("cauchy_stress", Values::tensors(&snap.sigma))?;
+    }
+    if has(Field::DeformationGradient) {
+        vtu.point_data("deformation_gradient", Values::tensors(&snap.f))?;
+    }
+    if has(Field::Volume) {
+        vtu.point_data("volume", Values::scalars(&snap.volume))?;
+    }
+    if has(Field::PlasticStrain) {
+        vtu.point_data(
+            "equivalent_plastic_strain",
+            Values::scalars(&snap.plastic_strain),
+        )?;
+    }
+    let (lower, upper) = bounds;
+    if present.domains && has(Field::Domain) {
+        vtu.point_data("domain_lower", Values::vectors(lower))?;
+        vtu.point_data("domain_upper", Values::vectors(upper))?;
+    }
+    if has(Field::Body) {
+        for (name, values) in constants {
+            vtu.point_data(name, Values::scalars(values))?;
+        }
+    }
+    Ok(vtu)
 }

@@ -278,15 +278,10 @@ fn errors_on_two_ranks(extra: &str) -> Vec<String> {
         .collect()
 }
 
-/// Loads with a curve are set by their place in the points' force list,
-/// which migration changes, and point fixities constrain nodes other ranks
-/// share: refused on several ranks, on every rank with the same message.
+/// Point fixities constrain nodes other ranks' points share: refused on
+/// several ranks, on every rank with the same message.
 #[test]
-fn an_explicit_load_with_a_curve_or_a_point_fixity_on_ranks_is_refused_on_every_rank() {
-    let curve = "\n[[curve]]\nname = \"ramp\"\npoints = [[0.0, 0.0], [1.0, 1.0]]\n\n[[load]]\nkind = \"point\"\nat = [0.5, 0.9]\nforce = [0.0, -1.0]\ncurve = \"ramp\"\n";
-    for e in errors_on_two_ranks(curve) {
-        assert!(e.contains("loads with a curve"), "{e}");
-    }
+fn an_explicit_point_fixity_on_ranks_is_refused_on_every_rank() {
     let held = "\n[[point_fixity]]\nregion = { box = { lower = [0.0, 0.5], upper = [0.07, 1.0] } }\nvelocity = { y = -0.5 }\n";
     for e in errors_on_two_ranks(held) {
         assert!(e.contains("point fixities"), "{e}");
@@ -354,4 +349,38 @@ fn the_ranks_report_what_they_sent() {
         assert!(r.migrated_points[1] > 0.0, "points cross between ranks");
         assert_eq!(r, outputs[0].ranks.unwrap(), "the same report everywhere");
     }
+}
+
+/// A point load on a curve (ramped on over 0.2 s, then held) on the
+/// column's top right corner and one on its top left (constant, then the
+/// curve's loads: the force list holds both kinds): on several ranks the
+/// list is made anew before every step with each force on its point by
+/// id, as points migrate and the cells are dealt anew. On 1 rank the one
+/// process bit for bit; on 2 and 4 ranks within issue 42's bounds.
+#[test]
+fn loads_on_a_curve_follow_their_points() {
+    let extra = "\n[[curve]]\nname = \"push\"\npoints = [[0.0, 0.0], [0.2, 1.0]]\n\
+                 [[load]]\nkind = \"point\"\nat = [0.97, 0.97]\nforce = [20.0, 0.0]\ncurve = \"push\"\n\
+                 [[load]]\nkind = \"point\"\nat = [0.03, 0.97]\nforce = [0.0, -5.0]\n";
+    let text = format!("{COLLAPSE}{extra}");
+    let strict = ["solver.rebalance_threshold=1.02".to_owned()];
+    let (scene, source) = scene::parse(&text, "ramped.toml", &strict).unwrap();
+    let problem = Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap();
+    let single = run_with(&problem, &RunControl::default());
+    let one = on_ranks(&problem, 1);
+    assert_eq!(one.energies, single.energies, "1 rank, bit for bit");
+    for size in [2, 4] {
+        let ranks = on_ranks(&problem, size);
+        assert_eq!(ranks.steps, single.steps, "{size} ranks");
+        let (dx, ds) = differences(&single.snapshots, &ranks.snapshots);
+        let de = energy_difference(&single.energies, &ranks.energies);
+        eprintln!(
+            "ramped, {size} ranks: |dx| {:.1e} h, |dσ| {ds:.1e}, energies {de:.1e}, {} new deals",
+            dx / H,
+            ranks.rebalances.len()
+        );
+        assert!(dx <= 1e-10 * H && ds <= 1e-9 && de <= 1e-10, "{size} ranks");
+    }
+    let work = single.energies.last().unwrap().external_work;
+    assert!(work > 0.0, "the loads do work: {work}");
 }

@@ -351,3 +351,58 @@ fn empty_grid_is_well_formed() {
     );
     assert!(data_array(&doc, "Points", "Points").numbers().is_empty());
 }
+
+/// The parallel master of pieces (`.pvtu`): read back with the XML
+/// parser, it declares every point and cell data array of the grid with
+/// its type and number of components, the points, and each piece by its
+/// file, in order — what VTK's `vtkXMLPUnstructuredGridReader` needs to
+/// open the pieces as one dataset.
+#[test]
+fn parallel_master_declares_the_arrays_and_names_the_pieces() {
+    let x = [[0.0, 0.0], [1.0, 2.0]];
+    let v = [[1.0, 2.0, 0.0], [3.0, 4.0, 0.0]];
+    let sigma = [[0.5; 9], [1.5; 9]];
+    let id = [3_i64, 4];
+    let mut grid = UnstructuredGrid::from_points(&x).unwrap();
+    grid.add_vertex_cells();
+    grid.point_data("velocity", Values::vectors(&v)).unwrap();
+    grid.point_data("cauchy_stress", Values::tensors(&sigma))
+        .unwrap();
+    grid.point_data("id & rank", Values::ints(&id)).unwrap();
+    let dir = fresh_dir("pvtu");
+    let path = dir.join("points_0003.pvtu");
+    let pieces = [
+        "points_0003_0.vtu".to_owned(),
+        "points_0003_1.vtu".to_owned(),
+    ];
+    grid.write_parallel(&path, &pieces).unwrap();
+    let doc = parse_xml(&std::fs::read_to_string(&path).unwrap());
+    assert_eq!(element(&doc, "VTKFile").attr("type"), "PUnstructuredGrid");
+    let declared: Vec<(&str, &str, &str, &str)> = doc
+        .iter()
+        .filter(|e| e.name == "PDataArray")
+        .map(|e| {
+            (
+                e.parent(),
+                e.attr("Name"),
+                e.attr("type"),
+                e.attr("NumberOfComponents"),
+            )
+        })
+        .collect();
+    assert_eq!(
+        declared,
+        [
+            ("PPointData", "velocity", "Float64", "3"),
+            ("PPointData", "cauchy_stress", "Float64", "9"),
+            ("PPointData", "id & rank", "Int64", "1"),
+            ("PPoints", "Points", "Float64", "3"),
+        ]
+    );
+    let sources: Vec<&str> = doc
+        .iter()
+        .filter(|e| e.name == "Piece")
+        .map(|e| e.attr("Source"))
+        .collect();
+    assert_eq!(sources, pieces);
+}

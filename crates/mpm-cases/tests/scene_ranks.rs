@@ -352,6 +352,7 @@ fn a_deal_that_does_not_fit_the_problem_is_refused_on_every_rank() {
                 rank_of_point: vec![0; 3],
                 rank_of_cell: Vec::new(),
                 balance: None,
+                pieces: None,
             }),
             ..RunControl::default()
         };

@@ -390,7 +390,11 @@ impl<const D: usize> Run<'_, '_, D> {
             }
             solver = solver.on_ranks(spread.ranks(), spread.initial_layout()?)?;
         }
-        let mut bound = Bound { solver, points };
+        let mut bound = Bound {
+            solver,
+            points,
+            local_of: Vec::new(),
+        };
         let mut out = Outputs {
             initial_position: &self.problem.position,
             control: self.control,
@@ -455,6 +459,9 @@ where
 {
     solver: ExplicitSolver<D, B, L, T, K, R>,
     points: PointsOf<D, B, L, T>,
+    /// On several ranks with loads on a curve: the local index of every
+    /// problem point last seen here, by id ([`place_point_forces`]).
+    local_of: Vec<usize>,
 }
 
 impl<const D: usize, B, L, T, K, R> Stepper<D> for Bound<D, B, L, T, K, R>
@@ -470,7 +477,19 @@ where
     }
 
     fn step(&mut self, setup: &ExplicitSetup<D>, max_dt: f64) -> Result<StepInfo, SolverError> {
-        scale_timed_forces(&mut self.points.point_force, setup, self.solver.time());
+        let t = self.solver.time();
+        if self.solver.rank().1 > 1 && !setup.timed_forces.is_empty() {
+            let points = &mut self.points;
+            place_point_forces(
+                &points.id,
+                &mut points.point_force,
+                &mut self.local_of,
+                setup,
+                t,
+            );
+        } else {
+            scale_timed_forces(&mut self.points.point_force, setup, t);
+        }
         self.solver.step(&mut self.points, max_dt)
     }
 
@@ -789,7 +808,9 @@ impl<const D: usize> Outputs<'_, '_, D> {
             let spread = self.spread.as_ref();
             let snapshot = snapshot(run, initial, at, control, clock, so_far, spread)?;
             match &self.spread {
-                Some(spread) => spread.observe_gathered(run.ids(), &snapshot, initial.len(), show),
+                Some(spread) => {
+                    spread.observe_gathered(clock.index, run.ids(), &snapshot, initial.len(), show)
+                }
                 None => show(&snapshot),
             }
         })
@@ -849,6 +870,43 @@ fn scale_timed_forces<const D: usize>(
         }
         at += n;
     }
+}
+
+/// The point forces of `setup` at time `t` on this rank's points: on
+/// several ranks a point's place in the force list changes as points
+/// migrate, so the list is made anew before every step from the problem's
+/// forces, each placed on its point by id (`local_of`, the local index of
+/// every id last seen here, kept between steps so that nothing is
+/// allocated per step), in the order of the problem's list: the
+/// constant forces, then those of every curve scaled by its factor.
+fn place_point_forces<const D: usize>(
+    ids: &[usize],
+    forces: &mut Vec<(usize, SVector<f64, D>)>,
+    local_of: &mut Vec<usize>,
+    setup: &ExplicitSetup<D>,
+    t: f64,
+) {
+    for (p, &id) in ids.iter().enumerate() {
+        if id >= local_of.len() {
+            local_of.resize(id + 1, usize::MAX);
+        }
+        local_of[id] = p;
+    }
+    let here = |id: usize| {
+        let p = local_of.get(id).copied().unwrap_or(usize::MAX);
+        (ids.get(p) == Some(&id)).then_some(p)
+    };
+    forces.clear();
+    let constant = setup.point_forces.iter().map(|&(id, f)| (id, f));
+    let timed = setup.timed_forces.iter().flat_map(|timed| {
+        let factor = timed.curve.at(t);
+        timed.forces.iter().map(move |&(id, f)| (id, f * factor))
+    });
+    forces.extend(
+        constant
+            .chain(timed)
+            .filter_map(|(id, f)| Some((here(id)?, f))),
+    );
 }
 
 /// Outputs after the initial state: `end_time / interval` rounded up (an

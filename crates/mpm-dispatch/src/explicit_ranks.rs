@@ -14,10 +14,10 @@
 //! same order, so the run goes on bit for bit; on another number (or from
 //! a one-process checkpoint), the cells are dealt from the points' cells.
 //!
-//! Point forces travel with their points (`mpm_solver`'s migration).
-//! Not yet on several ranks (refused): loads with a curve (their forces
-//! are set by their place in the points' force list, which migration
-//! changes), material-point fixities (a held point's multiplier changes
+//! Point forces travel with their points (`mpm_solver`'s migration);
+//! with loads on a curve the force list is made anew before every step,
+//! each force placed on its point by id. Not yet on several ranks
+//! (refused): material-point fixities (a held point's multiplier changes
 //! the velocities of nodes another rank's points share), the
 //! cell-averaged dilatation.
 
@@ -83,9 +83,6 @@ pub(crate) fn supported<const D: usize>(setup: &ExplicitSetup<D>) -> Result<(), 
             "{what} of an explicit scene on several ranks: not yet (issue 42); run it on one process"
         )))
     };
-    if !setup.timed_forces.is_empty() {
-        return refuse("loads with a curve");
-    }
     if !setup.point_fixities.is_empty() {
         return refuse("point fixities");
     }
@@ -450,11 +447,13 @@ impl<'a> Spread<'a> {
     /// The gather's, or the observer's on every rank.
     pub(crate) fn observe_gathered(
         &self,
+        index: usize,
         ids: &[usize],
         local: &Snapshot,
         total: usize,
         observe: impl FnOnce(&Snapshot) -> Result<(), SolverError>,
     ) -> Result<(), SolverError> {
+        self.run.write_piece(index, local, ids)?;
         let whole = self.gather(ids, local, total)?;
         ranks::agree(
             self.run.ranks.as_ref(),

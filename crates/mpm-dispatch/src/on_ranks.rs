@@ -40,6 +40,27 @@ pub struct RankRun {
     pub rank_of_cell: Vec<usize>,
     /// When an explicit run deals its cells anew; `None`: never.
     pub balance: Option<Balance>,
+    /// Writes this rank's piece of every output (each rank its own points,
+    /// before rank 0 observes them gathered); `None`: rank 0 alone writes.
+    pub pieces: Option<WritePiece>,
+}
+
+/// Writes a rank's piece of an output: called on every rank with the
+/// output's index (an implicit run's step, an explicit run's output), the
+/// rank's own points' snapshot, their indices in the problem and which
+/// optional fields the pieces hold; its outcome is decided over the ranks.
+pub type WritePiece =
+    Arc<dyn Fn(usize, &Snapshot, &[usize], PieceFields) -> Result<(), SolverError> + Send + Sync>;
+
+/// The optional fields every piece of an output holds, decided over the
+/// ranks (a rank without points cannot tell from its own snapshot, and
+/// the pieces of one output must hold the same arrays).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PieceFields {
+    /// The points' velocities (an explicit run).
+    pub velocity: bool,
+    /// The points' domain boxes (a basis with domains).
+    pub domains: bool,
 }
 
 impl std::fmt::Debug for RankRun {
@@ -104,6 +125,32 @@ pub fn imbalance(loads: &[f64], rank_of_cell: &[usize], ranks: usize) -> f64 {
 }
 
 impl RankRun {
+    /// This rank's piece of output `index` written, when pieces are
+    /// ([`RankRun::pieces`]); the outcome agreed over the ranks.
+    ///
+    /// # Errors
+    /// The transport's, or the lowest failing rank's error, on every rank.
+    pub fn write_piece(
+        &self,
+        index: usize,
+        local: &Snapshot,
+        ids: &[usize],
+    ) -> Result<(), SolverError> {
+        let Some(write) = &self.pieces else {
+            return Ok(());
+        };
+        let mut present = [
+            f64::from(u8::from(!local.velocity.is_empty())),
+            f64::from(u8::from(!local.domain_bounds.is_empty())),
+        ];
+        self.ranks.all_reduce(&mut present, Reduce::Max)?;
+        let fields = PieceFields {
+            velocity: present[0] > 0.0,
+            domains: present[1] > 0.0,
+        };
+        ranks::agree(self.ranks.as_ref(), write(index, local, ids, fields))
+    }
+
     /// Whether this is rank 0, the one that observes.
     pub fn is_root(&self) -> bool {
         self.ranks.rank() == 0

@@ -383,13 +383,16 @@ where
                 snapshot.tangent = now.stiffness.map(|k| k.to_sprs()).transpose()?;
             }
             match (&control.ranks, &own) {
-                (Some(r), Some(ids)) => on_ranks::observe_on_root(
-                    r.ranks.as_ref(),
-                    ids,
-                    &snapshot,
-                    total,
-                    &mut |whole| observer(step, report, whole),
-                )?,
+                (Some(r), Some(ids)) => {
+                    r.write_piece(step, &snapshot, ids)?;
+                    on_ranks::observe_on_root(
+                        r.ranks.as_ref(),
+                        ids,
+                        &snapshot,
+                        total,
+                        &mut |whole| observer(step, report, whole),
+                    )?;
+                }
                 _ => observer(step, report, &snapshot)?,
             }
             last_mesh = snapshot.mesh_nodes.take();

@@ -391,6 +391,59 @@ impl<'a> UnstructuredGrid<'a> {
         atomic_write_with(path, |w| self.write_xml(w))
     }
 
+    /// Writes to `path` (conventionally ending in `.pvtu`) the parallel
+    /// master of `pieces` (their file names, relative to `path`'s folder):
+    /// each piece a `.vtu` with the point and cell data arrays of this
+    /// grid, which ParaView then opens as one dataset. Atomic, as
+    /// [`UnstructuredGrid::write`].
+    ///
+    /// # Errors
+    /// [`OutputError::Io`] if the file cannot be written.
+    pub fn write_parallel(&self, path: &Path, pieces: &[String]) -> Result<(), OutputError> {
+        atomic_write_with(path, |w| self.write_parallel_xml(w, pieces))
+    }
+
+    fn write_parallel_xml(&self, w: &mut dyn Write, pieces: &[String]) -> io::Result<()> {
+        writeln!(w, r#"<?xml version="1.0"?>"#)?;
+        writeln!(
+            w,
+            r#"<VTKFile type="PUnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">"#
+        )?;
+        writeln!(w, r#"  <PUnstructuredGrid GhostLevel="0">"#)?;
+        for (tag, arrays) in [
+            ("PPointData", &self.point_data),
+            ("PCellData", &self.cell_data),
+        ] {
+            if arrays.is_empty() {
+                continue;
+            }
+            writeln!(w, "    <{tag}>")?;
+            for a in arrays {
+                let (kind, components) = match &a.values {
+                    Values::Float64 { components, .. } => ("Float64", *components),
+                    Values::Int64(_) => ("Int64", 1),
+                };
+                writeln!(
+                    w,
+                    r#"      <PDataArray type="{kind}" Name="{}" NumberOfComponents="{components}"/>"#,
+                    xml_escape(&a.name)
+                )?;
+            }
+            writeln!(w, "    </{tag}>")?;
+        }
+        writeln!(w, "    <PPoints>")?;
+        writeln!(
+            w,
+            r#"      <PDataArray type="Float64" Name="Points" NumberOfComponents="3"/>"#
+        )?;
+        writeln!(w, "    </PPoints>")?;
+        for piece in pieces {
+            writeln!(w, r#"    <Piece Source="{}"/>"#, xml_escape(piece))?;
+        }
+        writeln!(w, "  </PUnstructuredGrid>")?;
+        writeln!(w, "</VTKFile>")
+    }
+
     fn write_xml(&self, w: &mut dyn Write) -> io::Result<()> {
         writeln!(w, r#"<?xml version="1.0"?>"#)?;
         writeln!(

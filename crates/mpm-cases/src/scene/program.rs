@@ -2,12 +2,13 @@
 
 use serde_json::{Map, Value, json};
 
-use mpm_dispatch::on_ranks::{RankRun, SharedRanks};
+use mpm_dispatch::on_ranks::{RankRun, SharedRanks, WritePiece};
 
 use crate::CasesError;
 use crate::output::CellMesh;
 use crate::run::RunControl;
 use crate::session::{Session, observer_error, summary};
+use crate::writer::VtuOptions;
 
 /// A scene file describing a whole problem (no `case` key).
 /// Runs a scene file's text (`origin` names it in errors) with the
@@ -113,7 +114,8 @@ where
     crate::scene::Problem<D>: crate::scene::RunScene<D> + crate::scene::RunExplicit<D>,
 {
     let explicit = problem.explicit.is_some();
-    let run = super::ranks::rank_run(problem, shared.0.clone())?;
+    let mut run = super::ranks::rank_run(problem, shared.0.clone())?;
+    run.pieces = Some(piece_writer(problem, session, explicit));
     if run.is_root() {
         return Ok(Some(run));
     }
@@ -159,15 +161,12 @@ where
     crate::scene::Problem<D>: crate::scene::RunScene<D>,
 {
     use crate::output::CsvValue;
-    use crate::writer::VtuOptions;
 
     let (mut obs, mut control) = session.start(scene, mesh)?;
+    obs.writer
+        .set_pieces(ranks.as_ref().map_or(0, |r| r.ranks.size()));
     control.ranks = ranks;
-    obs.writer.set_vtu_options(VtuOptions {
-        every: problem.every,
-        fields: problem.fields.clone(),
-        constants: point_constants(problem),
-    });
+    obs.writer.set_vtu_options(vtu_options(problem, false));
     let axes = ["x", "y", "z"];
     let reaction_header: Vec<String> = std::iter::once("load_factor".to_owned())
         .chain(axes.iter().take(D).map(|a| format!("reaction_{a}")))
@@ -292,6 +291,37 @@ fn write_png<const D: usize>(
 }
 
 /// The per-point constants of the VTU files: body and material indices.
+/// What the VTU files of `problem` hold: every output of an explicit run,
+/// every `problem.every` steps of an implicit one.
+fn vtu_options<const D: usize>(problem: &crate::scene::Problem<D>, explicit: bool) -> VtuOptions {
+    VtuOptions {
+        every: if explicit { 1 } else { problem.every },
+        fields: problem.fields.clone(),
+        constants: point_constants(problem),
+    }
+}
+
+/// The writer of this rank's pieces of the points' files, into the
+/// session's folder: at the outputs rank 0's writer writes the points'
+/// files of (every output of an explicit run; the steps of an implicit
+/// one that [`crate::writer::writes_vtu`] names).
+fn piece_writer<const D: usize>(
+    problem: &crate::scene::Problem<D>,
+    session: &Session,
+    explicit: bool,
+) -> WritePiece {
+    let options = vtu_options(problem, explicit);
+    let dir = session.out.clone();
+    let rank = session.ranks.as_ref().map_or(0, |r| r.0.rank());
+    std::sync::Arc::new(move |index, snap, ids, fields| {
+        if !explicit && !crate::writer::writes_vtu(options.every, index, snap.load_factor) {
+            return Ok(());
+        }
+        crate::writer::write_piece(&dir, &options, (index, rank), snap, ids, fields)
+            .map_err(observer_error)
+    })
+}
+
 fn point_constants<const D: usize>(problem: &crate::scene::Problem<D>) -> Vec<(String, Vec<f64>)> {
     vec![
         (
@@ -341,7 +371,7 @@ where
 {
     use crate::output::CsvValue;
     use crate::scene::ExplicitEvent;
-    use crate::writer::{ExplicitSummary, VtuOptions};
+    use crate::writer::ExplicitSummary;
 
     let Some(setup) = problem.explicit.as_ref() else {
         return Err(CasesError::Solver(mpm_solver::SolverError::InvalidInput(
@@ -350,14 +380,12 @@ where
     };
     let end_time = setup.end_time;
     let (mut obs, mut control) = session.start(scene, grid)?;
+    obs.writer
+        .set_pieces(ranks.as_ref().map_or(0, |r| r.ranks.size()));
     control.ranks = ranks;
     let mut rebalances = Vec::new();
     obs.show_time();
-    obs.writer.set_vtu_options(VtuOptions {
-        every: 1,
-        fields: problem.fields.clone(),
-        constants: point_constants(problem),
-    });
+    obs.writer.set_vtu_options(vtu_options(problem, true));
     const ENERGY_HEADER: [&str; 6] = [
         "time",
         "kinetic",

@@ -101,6 +101,7 @@ pub fn rank_run<const D: usize>(
         rank_of_point,
         rank_of_cell,
         balance,
+        pieces: None,
     })
 }
 
