@@ -16,10 +16,11 @@
 //!
 //! Point forces travel with their points (`mpm_solver`'s migration);
 //! with loads on a curve the force list is made anew before every step,
-//! each force placed on its point by id. Not yet on several ranks
-//! (refused): material-point fixities (a held point's multiplier changes
-//! the velocities of nodes another rank's points share), the
-//! cell-averaged dilatation.
+//! each force placed on its point by id. The cell-averaged dilatation
+//! needs no communication: the points follow their cells. Not yet on
+//! several ranks (refused): material-point fixities (a held point's
+//! multiplier changes the velocities of nodes another rank's points
+//! share).
 
 use std::sync::Arc;
 

@@ -455,7 +455,9 @@ where
         points: &mut PointsOf<D, B, L, T>,
         max_dt: f64,
     ) -> Result<StepInfo, SolverError> {
-        let admissible = self.admissible_increment(points, max_dt);
+        let admissible = self
+            .admissible_increment(points, max_dt)
+            .and_then(|dt| self.check_cells_held(points).map(|()| dt));
         let dt = self.collective(admissible)?;
         let held = self.hold_fixed_points(points);
         self.collective(held)?;

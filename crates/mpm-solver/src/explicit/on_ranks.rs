@@ -35,10 +35,14 @@ where
     /// points it is given (those of its cells, with their global ids) and
     /// meets the other ranks through `ranks` as `layout` says.
     ///
+    /// Under the cell-averaged dilatation a cell's average needs all its
+    /// points: each step checks that every point starts it in a cell of
+    /// its own rank (as when the points follow their cells, migrating
+    /// after every step: [`Self::migrate`]), so the averages need no
+    /// communication.
+    ///
     /// # Errors
-    /// A decomposition that does not fit the mesh or the ranks; the
-    /// cell-averaged dilatation (its cell sums would need the points of
-    /// other ranks: not yet supported).
+    /// A decomposition that does not fit the mesh or the ranks.
     pub fn on_ranks(
         mut self,
         ranks: Box<dyn Ranks>,
@@ -50,11 +54,6 @@ where
             self.mesh.cell_count(),
             self.node_count,
         )?;
-        if K::AVERAGES {
-            return Err(SolverError::InvalidInput(
-                "the cell-averaged dilatation is not yet supported on more than one rank".into(),
-            ));
-        }
         self.on_ranks = Some(OnRanks {
             ranks,
             layout,
@@ -69,6 +68,37 @@ where
         self.on_ranks
             .as_ref()
             .map_or((0, 1), |on| (on.ranks.rank(), on.ranks.size()))
+    }
+
+    /// Under the cell-averaged dilatation on several ranks, that every
+    /// point starts the step in a cell of its own rank ([`Self::on_ranks`]);
+    /// nothing otherwise. Not collective.
+    ///
+    /// # Errors
+    /// [`SolverError::InvalidInput`] naming the first point held by
+    /// another rank than its cell's.
+    pub(super) fn check_cells_held(
+        &self,
+        points: &PointsOf<D, B, L, T>,
+    ) -> Result<(), SolverError> {
+        let Some(on) = self.on_ranks.as_ref().filter(|_| K::AVERAGES) else {
+            return Ok(());
+        };
+        let me = on.ranks.rank();
+        for (p, x) in points.position.iter().enumerate() {
+            let cell = self.mesh.cell_of(x);
+            let owner = cell.and_then(|c| on.layout.rank_of_cell.get(c).copied());
+            if let (Some(c), Some(r)) = (cell, owner)
+                && r != me
+            {
+                return Err(SolverError::InvalidInput(format!(
+                    "the cell-averaged dilatation needs every point of a cell on its rank: \
+                     material point {} of rank {me} is in cell {c} of rank {r}",
+                    points.id.get(p).copied().unwrap_or(p)
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// A local outcome decided over the ranks ([`ranks::agree`]).
