@@ -83,7 +83,7 @@ use mpm_scene::variant::{LockingKind, VariantVisitor, dispatch_in};
 use crate::explicit_law::{ExplicitLaw, ExplicitLaws};
 pub use crate::explicit_ranks::RanksReport;
 pub use crate::explicit_ranks::Rebalanced;
-use crate::explicit_ranks::{self, Spread};
+use crate::explicit_ranks::Spread;
 use mpm_scene::build::{ExplicitSetup, Problem, SceneMesh};
 use mpm_scene::format::TransferKind;
 use mpm_solver::ranks::Decomposition;
@@ -229,10 +229,7 @@ fn dispatch<const D: usize>(
     control: &RunControl,
     observer: &mut ExplicitObserver<'_>,
 ) -> Result<ExplicitOutput, SolverError> {
-    let (_, setup) = parts(problem)?;
-    if control.ranks.is_some() {
-        explicit_ranks::supported(setup)?;
-    }
+    parts(problem)?;
     let run = Run {
         problem,
         control,

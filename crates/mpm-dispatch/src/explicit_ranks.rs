@@ -17,15 +17,13 @@
 //! Point forces travel with their points (`mpm_solver`'s migration);
 //! with loads on a curve the force list is made anew before every step,
 //! each force placed on its point by id. The cell-averaged dilatation
-//! needs no communication: the points follow their cells. Not yet on
-//! several ranks (refused): material-point fixities (a held point's
-//! multiplier changes the velocities of nodes another rank's points
-//! share).
+//! needs no communication: the points follow their cells. Material-point
+//! fixities are held by every rank together (`mpm_solver`'s
+//! `hold_over_ranks`).
 
 use std::sync::Arc;
 
 use mpm_mesh::RegularGrid;
-use mpm_scene::build::ExplicitSetup;
 use mpm_solver::SolverError;
 use mpm_solver::ranks::{self, Decomposition, Ranks, Reduce};
 
@@ -72,22 +70,6 @@ pub struct RanksReport {
     pub collectives: [f64; 2],
     /// Points sent to another rank after a step or by a new deal.
     pub migrated_points: [f64; 2],
-}
-
-/// What a run on several ranks does not do yet.
-///
-/// # Errors
-/// [`SolverError::InvalidInput`] naming it.
-pub(crate) fn supported<const D: usize>(setup: &ExplicitSetup<D>) -> Result<(), SolverError> {
-    let refuse = |what: &str| {
-        Err(SolverError::InvalidInput(format!(
-            "{what} of an explicit scene on several ranks: not yet (issue 42); run it on one process"
-        )))
-    };
-    if !setup.point_fixities.is_empty() {
-        return refuse("point fixities");
-    }
-    Ok(())
 }
 
 /// From a checkpoint's `held` of `size` ranks (as [`Spread::join`] wrote

@@ -90,6 +90,33 @@ pub fn hold_points<const D: usize>(
     ends: &[usize],
     fixities: &VelocityFixities,
 ) -> f64 {
+    let scale = velocity_scale(grid, held);
+    hold_points_to(grid, held, (pairs, ends), fixities, scale)
+}
+
+/// The velocity scale of [`hold_points`]' tolerance: the largest held
+/// value or updated grid velocity component.
+pub fn velocity_scale<const D: usize>(grid: &GridState<D>, held: &[(usize, usize, f64)]) -> f64 {
+    held.iter()
+        .map(|h| h.2.abs())
+        .fold(0.0, f64::max)
+        .max(
+            grid.velocity[grid.lo..grid.hi]
+                .iter()
+                .map(|v| v.new.amax())
+                .fold(0.0, f64::max),
+        )
+        .max(f64::MIN_POSITIVE)
+}
+
+/// [`hold_points`] to the tolerance 1e-12 × `scale`.
+pub fn hold_points_to<const D: usize>(
+    grid: &mut GridState<D>,
+    held: &[(usize, usize, f64)],
+    (pairs, ends): (&[(usize, f64)], &[usize]),
+    fixities: &VelocityFixities,
+    scale: f64,
+) -> f64 {
     let stencils = ends.iter().scan(0, |start, &end| {
         let s = &pairs[*start..end];
         *start = end;
@@ -101,17 +128,6 @@ pub fn hold_points<const D: usize>(
             .binary_search_by(|&(n, k, _)| (n, k).cmp(&(node, c)))
             .is_ok()
     };
-    let scale = held
-        .iter()
-        .map(|h| h.2.abs())
-        .fold(0.0, f64::max)
-        .max(
-            grid.velocity[grid.lo..grid.hi]
-                .iter()
-                .map(|v| v.new.amax())
-                .fold(0.0, f64::max),
-        )
-        .max(f64::MIN_POSITIVE);
     let mut worst = 0.0;
     for _ in 0..100 {
         worst = 0.0f64;

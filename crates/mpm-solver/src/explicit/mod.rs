@@ -471,6 +471,7 @@ where
             .time(Stage::Grid, || self.update_grid(points, dt))
             .map_err(|e| self.point_failure(&points.id, e));
         self.collective(updated)?;
+        clock.time(Stage::Grid, || self.hold_over_ranks(points))?;
         let work = self.point_force_power(points);
         let gathered = clock
             .time(Stage::G2p, || self.gather(points, dt))
@@ -550,7 +551,9 @@ where
         dt: f64,
     ) -> Result<(), (usize, PointFailure)> {
         grid_update::update(&self.buffers, &mut self.grid, dt, &self.fixities);
-        if !points.fixed_velocity.is_empty() {
+        // On several ranks the stencils are rebuilt even when this rank
+        // holds no point now (its held points may have migrated away).
+        if !points.fixed_velocity.is_empty() || self.on_ranks.is_some() {
             self.hold_on_grid(points)?;
         }
         Ok(())
@@ -613,14 +616,6 @@ where
     /// start.
     fn hold_fixed_points(&mut self, points: &mut PointsOf<D, B, L, T>) -> Result<(), SolverError> {
         self.fixed_start.clear();
-        let on_ranks = self.on_ranks.is_some();
-        // A held point's multiplier changes the velocities of its nodes,
-        // which another rank's points may share without knowing of it.
-        if on_ranks && !points.fixed_velocity.is_empty() {
-            return Err(SolverError::InvalidInput(
-                "material-point fixities are not yet supported on more than one rank".into(),
-            ));
-        }
         for &(p, c, v) in &points.fixed_velocity {
             if p >= points.len() || c >= D || !v.is_finite() {
                 return Err(SolverError::InvalidInput(format!(
@@ -634,8 +629,11 @@ where
         Ok(())
     }
 
-    /// The grid side of the material-point fixities
-    /// ([`grid_update::hold_points`]).
+    /// The (node, weight) pairs of every held point of this rank
+    /// ([`Self::held_stencils`]), then on one rank their grid side
+    /// ([`grid_update::hold_points`]); on several the ranks hold them
+    /// together after the step's failures are agreed
+    /// ([`Self::hold_over_ranks`]).
     fn hold_on_grid(&mut self, points: &PointsOf<D, B, L, T>) -> Result<(), (usize, PointFailure)> {
         let mut stencil = self.basis.new_stencil();
         // Buffers kept between steps: no allocation per held point.
@@ -655,13 +653,15 @@ where
             .map_err(|e| (p, e))?;
             ends.push(pairs.len());
         }
-        grid_update::hold_points(
-            &mut self.grid,
-            &points.fixed_velocity,
-            pairs,
-            ends,
-            &self.fixities,
-        );
+        if self.on_ranks.is_none() {
+            grid_update::hold_points(
+                &mut self.grid,
+                &points.fixed_velocity,
+                pairs,
+                ends,
+                &self.fixities,
+            );
+        }
         Ok(())
     }
 

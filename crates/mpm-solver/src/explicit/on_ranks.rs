@@ -7,7 +7,10 @@
 use mpm_basis::BasisFunction;
 use mpm_constitutive::IncrementalLaw;
 
-use super::{DilatationTreatment, ExplicitMesh, ExplicitSolver, PointsOf, Transfer, migrate};
+use super::grid::GridState;
+use super::{
+    DilatationTreatment, ExplicitMesh, ExplicitSolver, PointsOf, Transfer, grid_update, migrate,
+};
 use crate::checkpoint::Flat;
 use crate::domain::DomainUpdater;
 use crate::error::SolverError;
@@ -20,6 +23,9 @@ pub(super) struct OnRanks {
     layout: Decomposition,
     halo: Halo,
     migration: migrate::Migration,
+    /// Whether any rank holds material points (their fixities stay with
+    /// them, so this is asked once).
+    any_held: Option<bool>,
 }
 
 impl<const D: usize, B, L, T, K, R> ExplicitSolver<D, B, L, T, K, R>
@@ -59,6 +65,7 @@ where
             layout,
             halo: Halo::default(),
             migration: migrate::Migration::default(),
+            any_held: None,
         });
         Ok(self)
     }
@@ -96,6 +103,71 @@ where
                      material point {} of rank {me} is in cell {c} of rank {r}",
                     points.id.get(p).copied().unwrap_or(p)
                 )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The material-point fixities on several ranks: a held point's
+    /// multiplier changes the velocities of its nodes, which other ranks'
+    /// points share, and the held points couple where their stencils meet.
+    /// So every rank gathers every held point (its global id, component,
+    /// value and (node, weight) pairs) and the updated mass and velocity
+    /// of every node of their stencils (from the lowest rank holding the
+    /// node: the halo has given each the totals), runs the same
+    /// Gauss–Seidel sweeps ([`grid_update::hold_points_to`], in the order
+    /// of the points' ids, to the tolerance of the whole grid's velocity
+    /// scale) on that small grid, and takes back the velocities of the
+    /// nodes its own points touch. Collective; nothing on one rank or
+    /// when no rank holds points.
+    ///
+    /// # Errors
+    /// The transport's.
+    pub(super) fn hold_over_ranks(
+        &mut self,
+        points: &PointsOf<D, B, L, T>,
+    ) -> Result<(), SolverError> {
+        let Some(on) = &mut self.on_ranks else {
+            return Ok(());
+        };
+        let held = &points.fixed_velocity;
+        let any = match on.any_held {
+            Some(any) => any,
+            None => {
+                let mut count = [held.len() as f64];
+                on.ranks.all_reduce(&mut count, Reduce::Sum)?;
+                *on.any_held.insert(count[0] > 0.0)
+            }
+        };
+        if !any {
+            return Ok(());
+        }
+        let ranks = on.ranks.as_ref();
+        let (pairs, ends) = &self.held_stencils;
+        let all = gather_held(ranks, held, &points.id, pairs, ends)?;
+        let nodes = stencil_nodes(&all);
+        let mut small = node_totals(ranks, &self.grid, &nodes)?;
+        let mut scale = [grid_update::velocity_scale(&self.grid, held)];
+        ranks.all_reduce(&mut scale, Reduce::Max)?;
+        let compact = |i: usize| nodes.binary_search(&i).unwrap_or(0);
+        let (held_all, small_pairs, small_ends) = all.compact(compact);
+        let mut fixities = crate::explicit::VelocityFixities::new();
+        for &(n, c, v) in self.fixities.entries() {
+            if let Ok(k) = nodes.binary_search(&n) {
+                fixities.prescribe([k], c, v);
+            }
+        }
+        fixities.finish();
+        grid_update::hold_points_to(
+            &mut small,
+            &held_all,
+            (&small_pairs, &small_ends),
+            &fixities,
+            scale[0],
+        );
+        for (k, &i) in nodes.iter().enumerate() {
+            if touched(&self.grid, i) {
+                self.grid.velocity[i].new = small.velocity[k].new;
             }
         }
         Ok(())
@@ -238,4 +310,127 @@ where
         on.layout = layout;
         Ok(moved)
     }
+}
+
+/// A held point: (point, component, value).
+type Held = (usize, usize, f64);
+
+/// A point's (node, weight) pairs.
+type Stencil = Vec<(usize, f64)>;
+
+/// Every rank's held points, in the order of their ids: (id, component,
+/// value) and their (node, weight) pairs.
+struct HeldPoints {
+    points: Vec<Held>,
+    stencils: Vec<Stencil>,
+}
+
+impl HeldPoints {
+    /// The held points with their stencils' nodes renumbered by
+    /// `compact`, as [`grid_update::hold_points_to`] takes them (the
+    /// point indices are not used there).
+    fn compact(&self, compact: impl Fn(usize) -> usize) -> (Vec<Held>, Stencil, Vec<usize>) {
+        let mut pairs = Vec::new();
+        let mut ends = Vec::with_capacity(self.stencils.len());
+        for stencil in &self.stencils {
+            pairs.extend(stencil.iter().map(|&(i, w)| (compact(i), w)));
+            ends.push(pairs.len());
+        }
+        (self.points.clone(), pairs, ends)
+    }
+}
+
+/// Every rank's held points (this rank's `held`, named by `ids`, with
+/// the stencils `pairs`/`ends`), sorted by id and component: the same on
+/// every rank. Two reductions: the lengths, then the records, each rank
+/// writing its own span.
+fn gather_held(
+    ranks: &dyn Ranks,
+    held: &[(usize, usize, f64)],
+    ids: &[usize],
+    pairs: &[(usize, f64)],
+    ends: &[usize],
+) -> Result<HeldPoints, SolverError> {
+    // Per held point: id, component, value, count, then (node, weight)s.
+    let mut mine = Vec::new();
+    let mut start = 0;
+    for (&(p, c, v), &end) in held.iter().zip(ends) {
+        let stencil = &pairs[start..end];
+        start = end;
+        mine.extend([ids.get(p).copied().unwrap_or(p) as f64, c as f64, v]);
+        mine.push(stencil.len() as f64);
+        mine.extend(stencil.iter().flat_map(|&(i, w)| [i as f64, w]));
+    }
+    let (me, size) = (ranks.rank(), ranks.size());
+    let mut lengths = vec![0.0; size];
+    lengths[me] = mine.len() as f64;
+    ranks.all_reduce(&mut lengths, Reduce::Sum)?;
+    let offset: usize = lengths[..me].iter().map(|&l| l as usize).sum();
+    let total: usize = lengths.iter().map(|&l| l as usize).sum();
+    let mut all = vec![0.0; total];
+    all[offset..offset + mine.len()].copy_from_slice(&mine);
+    ranks.all_reduce(&mut all, Reduce::Sum)?;
+    let mut records = Vec::new();
+    let mut k = 0;
+    while k + 4 <= all.len() {
+        let count = all[k + 3] as usize;
+        let stencil = (0..count)
+            .map(|j| (all[k + 4 + 2 * j] as usize, all[k + 5 + 2 * j]))
+            .collect();
+        records.push(((all[k] as usize, all[k + 1] as usize, all[k + 2]), stencil));
+        k += 4 + 2 * count;
+    }
+    records.sort_by_key(|(h, _): &(Held, Stencil)| (h.0, h.1));
+    let (points, stencils) = records.into_iter().unzip();
+    Ok(HeldPoints { points, stencils })
+}
+
+/// Whether this rank's points touched node `i` in this step: the grid
+/// keeps the values of earlier steps outside its range `lo..hi`.
+fn touched<const D: usize>(grid: &GridState<D>, i: usize) -> bool {
+    (grid.lo..grid.hi).contains(&i) && grid.mass[i] > 0.0
+}
+
+/// The nodes of every held point's stencil, ascending, once.
+fn stencil_nodes(held: &HeldPoints) -> Vec<usize> {
+    let mut nodes: Vec<usize> = held.stencils.iter().flatten().map(|&(i, _)| i).collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
+}
+
+/// A grid of the `nodes` alone with their updated masses and velocities,
+/// each from the lowest rank whose points touched the node in this step
+/// (after the halo every such rank holds the totals).
+fn node_totals<const D: usize>(
+    ranks: &dyn Ranks,
+    grid: &GridState<D>,
+    nodes: &[usize],
+) -> Result<GridState<D>, SolverError> {
+    let me = ranks.rank() as f64;
+    let mut lowest: Vec<f64> = (nodes.iter())
+        .map(|&i| if touched(grid, i) { me } else { f64::INFINITY })
+        .collect();
+    ranks.all_reduce(&mut lowest, Reduce::Min)?;
+    let width = D + 1;
+    let mut values = vec![0.0; nodes.len() * width];
+    for (k, &i) in nodes.iter().enumerate() {
+        if lowest[k] == me {
+            values[k * width] = grid.mass[i];
+            for c in 0..D {
+                values[k * width + 1 + c] = grid.velocity[i].new[c];
+            }
+        }
+    }
+    ranks.all_reduce(&mut values, Reduce::Sum)?;
+    let mut small = GridState::new(nodes.len());
+    for k in 0..nodes.len() {
+        small.mass[k] = values[k * width];
+        for c in 0..D {
+            small.velocity[k].new[c] = values[k * width + 1 + c];
+        }
+    }
+    small.lo = 0;
+    small.hi = nodes.len();
+    Ok(small)
 }
