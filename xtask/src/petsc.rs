@@ -21,11 +21,15 @@ use crate::scene_run::Run;
 use crate::vane;
 
 /// The solvers compared: a label and the `solver.linear` override.
-const SOLVERS: [(&str, &str); 4] = [
+const SOLVERS: [(&str, &str); 5] = [
     ("ours: ILU(0) + BiCGSTAB (faer)", "\"iterative\""),
     (
         "PETSc: BiCGSTAB + GAMG (interpolation reused in a step)",
         "{ petsc = \"-ksp_type bcgs -pc_type gamg -pc_gamg_reuse_interpolation true\" }",
+    ),
+    (
+        "PETSc: BiCGSTAB + GAMG (unsmoothed aggregation, preconditioner kept through a step)",
+        "{ petsc = \"-ksp_type bcgs -pc_type gamg -pc_gamg_agg_nsmooths 0 -ksp_reuse_preconditioner true\" }",
     ),
     (
         "PETSc: GMRES(100) + hypre BoomerAMG (3D settings)",
