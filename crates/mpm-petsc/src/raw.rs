@@ -491,51 +491,6 @@ impl Vector {
         self.write(s, part)
     }
 
-    /// The whole vector into `whole` on every process (a scatter to all
-    /// processes; collective).
-    ///
-    /// # Errors
-    /// The length is not the vector's, or PETSc failed.
-    pub fn read_whole(&self, s: &Session, whole: &mut [f64]) -> Result<(), PetscError> {
-        let mut scatter: ffi::VecScatter = ptr::null_mut();
-        let mut all: ffi::Vec = ptr::null_mut();
-        // SAFETY: a live vector; the scatter and the sequential vector it
-        // creates are owned by `Vector` (destroyed when dropped) and
-        // destroyed below.
-        unsafe {
-            check(
-                ffi::VecScatterCreateToAll(self.0, &mut scatter, &mut all),
-                "VecScatterCreateToAll",
-            )?;
-            let all = Vector(all);
-            let moved = check(
-                ffi::VecScatterBegin(
-                    scatter,
-                    self.0,
-                    all.0,
-                    ffi::INSERT_VALUES,
-                    ffi::SCATTER_FORWARD,
-                ),
-                "VecScatterBegin",
-            )
-            .and_then(|()| {
-                check(
-                    ffi::VecScatterEnd(
-                        scatter,
-                        self.0,
-                        all.0,
-                        ffi::INSERT_VALUES,
-                        ffi::SCATTER_FORWARD,
-                    ),
-                    "VecScatterEnd",
-                )
-            });
-            ffi::VecScatterDestroy(&mut scatter);
-            moved?;
-            all.read(s, whole)
-        }
-    }
-
     fn local_len(&self) -> usize {
         let mut n: Int = 0;
         // SAFETY: a live vector.
@@ -553,6 +508,83 @@ impl Drop for Vector {
         if let Ok(_s) = lock() {
             // SAFETY: the vector this owner created.
             unsafe { ffi::VecDestroy(&mut self.0) };
+        }
+    }
+}
+
+/// A scatter of a parallel vector to a whole copy on every process
+/// (`VecScatterCreateToAll`), made once for a vector layout and used for
+/// every vector of it (collective).
+pub struct ToAll {
+    scatter: ffi::VecScatter,
+    all: Vector,
+}
+
+// SAFETY: as for `Matrix`: touched only under the process lock.
+unsafe impl Send for ToAll {}
+
+impl ToAll {
+    /// The scatter of vectors laid out as `like`.
+    ///
+    /// # Errors
+    /// PETSc failed.
+    pub fn new(_s: &Session, like: &Vector) -> Result<Self, PetscError> {
+        let mut scatter: ffi::VecScatter = ptr::null_mut();
+        let mut all: ffi::Vec = ptr::null_mut();
+        // SAFETY: a live vector; out-pointers to a new scatter and a new
+        // sequential vector, destroyed by this owner.
+        check(
+            unsafe { ffi::VecScatterCreateToAll(like.0, &mut scatter, &mut all) },
+            "VecScatterCreateToAll",
+        )?;
+        Ok(Self {
+            scatter,
+            all: Vector(all),
+        })
+    }
+
+    /// The whole of `from` into `whole`, on every process.
+    ///
+    /// # Errors
+    /// The length is not the vector's, or PETSc failed.
+    pub fn gather(
+        &mut self,
+        s: &Session,
+        from: &Vector,
+        whole: &mut [f64],
+    ) -> Result<(), PetscError> {
+        // SAFETY: a live scatter between `from`'s layout and `all`.
+        unsafe {
+            check(
+                ffi::VecScatterBegin(
+                    self.scatter,
+                    from.0,
+                    self.all.0,
+                    ffi::INSERT_VALUES,
+                    ffi::SCATTER_FORWARD,
+                ),
+                "VecScatterBegin",
+            )?;
+            check(
+                ffi::VecScatterEnd(
+                    self.scatter,
+                    from.0,
+                    self.all.0,
+                    ffi::INSERT_VALUES,
+                    ffi::SCATTER_FORWARD,
+                ),
+                "VecScatterEnd",
+            )?;
+        }
+        self.all.read(s, whole)
+    }
+}
+
+impl Drop for ToAll {
+    fn drop(&mut self) {
+        if let Ok(_s) = lock() {
+            // SAFETY: the scatter this owner created.
+            unsafe { ffi::VecScatterDestroy(&mut self.scatter) };
         }
     }
 }

@@ -21,7 +21,7 @@ use mpm_solver::linear::{check_dimensions, check_pattern};
 use mpm_solver::{Factorisation, IterativeOptions, LinearSolveError, LinearSolver};
 
 use crate::PetscError;
-use crate::raw::{self, Int, Krylov, Matrix, Options, Vector};
+use crate::raw::{self, Int, Krylov, Matrix, Options, ToAll, Vector};
 
 /// PETSc's `KSP_DIVERGED_ITS`: the iteration limit reached.
 const DIVERGED_ITS: i32 = -3;
@@ -52,6 +52,8 @@ struct Step {
     options: Options,
     b: Vector,
     x: Vector,
+    /// The solution's scatter to every process, made once per step.
+    to_all: ToAll,
 }
 
 impl std::fmt::Debug for PetscLinear {
@@ -158,6 +160,7 @@ impl PetscLinear {
         let ksp = Krylov::new(&s, &matrix, &options, self.tolerances.rel_tolerance, max_it)?;
         let b = matrix.vector(&s)?;
         let x = matrix.vector(&s)?;
+        let to_all = ToAll::new(&s, &x)?;
         Ok(Step {
             n,
             nnz: row_idx.len(),
@@ -168,6 +171,7 @@ impl PetscLinear {
             options,
             b,
             x,
+            to_all,
         })
     }
 }
@@ -276,7 +280,7 @@ impl LinearSolver for PetscLinear {
                 ),
             });
         }
-        step.x.read_whole(&s, rhs)?;
+        step.to_all.gather(&s, &step.x, rhs)?;
         if let Some(dof) = rhs.iter().position(|v| !v.is_finite()) {
             return Err(LinearSolveError::NonFinite {
                 factorisation: Factorisation::Iterative,
