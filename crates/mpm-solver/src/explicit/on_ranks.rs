@@ -144,13 +144,15 @@ where
         }
         let ranks = on.ranks.as_ref();
         let (pairs, ends) = &self.held_stencils;
-        let all = gather_held(ranks, held, &points.id, pairs, ends)?;
+        let mut all = gather_held(ranks, held, &points.id, pairs, ends)?;
         let nodes = stencil_nodes(&all);
         let mut small = node_totals(ranks, &self.grid, &nodes)?;
         let mut scale = [grid_update::velocity_scale(&self.grid, held)];
         ranks.all_reduce(&mut scale, Reduce::Max)?;
-        let compact = |i: usize| nodes.binary_search(&i).unwrap_or(0);
-        let (held_all, small_pairs, small_ends) = all.compact(compact);
+        // The stencils on the small grid of `nodes`.
+        for (i, _) in &mut all.pairs {
+            *i = nodes.binary_search(i).unwrap_or(0);
+        }
         let mut fixities = crate::explicit::VelocityFixities::new();
         for &(n, c, v) in self.fixities.entries() {
             if let Ok(k) = nodes.binary_search(&n) {
@@ -160,8 +162,8 @@ where
         fixities.finish();
         grid_update::hold_points_to(
             &mut small,
-            &held_all,
-            (&small_pairs, &small_ends),
+            &all.points,
+            (&all.pairs, &all.ends),
             &fixities,
             scale[0],
         );
@@ -319,25 +321,12 @@ type Held = (usize, usize, f64);
 type Stencil = Vec<(usize, f64)>;
 
 /// Every rank's held points, in the order of their ids: (id, component,
-/// value) and their (node, weight) pairs.
+/// value), and their (node, weight) pairs, point k's at
+/// `pairs[ends[k-1]..ends[k]]` (from 0 for the first).
 struct HeldPoints {
     points: Vec<Held>,
-    stencils: Vec<Stencil>,
-}
-
-impl HeldPoints {
-    /// The held points with their stencils' nodes renumbered by
-    /// `compact`, as [`grid_update::hold_points_to`] takes them (the
-    /// point indices are not used there).
-    fn compact(&self, compact: impl Fn(usize) -> usize) -> (Vec<Held>, Stencil, Vec<usize>) {
-        let mut pairs = Vec::new();
-        let mut ends = Vec::with_capacity(self.stencils.len());
-        for stencil in &self.stencils {
-            pairs.extend(stencil.iter().map(|&(i, w)| (compact(i), w)));
-            ends.push(pairs.len());
-        }
-        (self.points.clone(), pairs, ends)
-    }
+    pairs: Stencil,
+    ends: Vec<usize>,
 }
 
 /// Every rank's held points (this rank's `held`, named by `ids`, with
@@ -381,8 +370,17 @@ fn gather_held(
         k += 4 + 2 * count;
     }
     records.sort_by_key(|(h, _): &(Held, Stencil)| (h.0, h.1));
-    let (points, stencils) = records.into_iter().unzip();
-    Ok(HeldPoints { points, stencils })
+    let mut held = HeldPoints {
+        points: Vec::with_capacity(records.len()),
+        pairs: Vec::new(),
+        ends: Vec::with_capacity(records.len()),
+    };
+    for (point, stencil) in records {
+        held.points.push(point);
+        held.pairs.extend(stencil);
+        held.ends.push(held.pairs.len());
+    }
+    Ok(held)
 }
 
 /// Whether this rank's points touched node `i` in this step: the grid
@@ -393,7 +391,7 @@ fn touched<const D: usize>(grid: &GridState<D>, i: usize) -> bool {
 
 /// The nodes of every held point's stencil, ascending, once.
 fn stencil_nodes(held: &HeldPoints) -> Vec<usize> {
-    let mut nodes: Vec<usize> = held.stencils.iter().flatten().map(|&(i, _)| i).collect();
+    let mut nodes: Vec<usize> = held.pairs.iter().map(|&(i, _)| i).collect();
     nodes.sort_unstable();
     nodes.dedup();
     nodes
