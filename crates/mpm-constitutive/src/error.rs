@@ -60,6 +60,16 @@ pub enum ConstitutiveError {
         /// The value given.
         value: f64,
     },
+    /// A law's parameter outside its range.
+    #[error("{name} = {value} must be {range}")]
+    InvalidParameter {
+        /// The parameter, e.g. `"friction angle"`.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// Its range, in words.
+        range: &'static str,
+    },
     /// A [`crate::MaterialSet`] needs at least one law and at most
     /// `u32::MAX` of them.
     #[error("a material set holds {count} laws; it needs 1 to 2^32 - 1")]

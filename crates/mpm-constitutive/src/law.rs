@@ -46,6 +46,22 @@ pub trait LogStrainLaw: Send + Sync {
     /// laws and associated plasticity with a closest-point return.
     const SYMMETRIC_TANGENT: bool = true;
 
+    /// Whether this law's $D^{alg}$ is major-symmetric: per law for a
+    /// family whose [`Self::SYMMETRIC_TANGENT`] must hold for its every
+    /// member (e.g. associated soil plasticity, $\psi = \phi$). Default:
+    /// [`Self::SYMMETRIC_TANGENT`].
+    fn symmetric_tangent(&self) -> bool {
+        Self::SYMMETRIC_TANGENT
+    }
+
+    /// A code of the part of the yield surface `state` was returned to,
+    /// for checks that compare like with like (a finite difference must
+    /// not straddle a change of regime): 0 elastic, 1 plastic by default;
+    /// multi-surface laws give their [`crate::principal::Regime`].
+    fn regime(&self, state: &LawState<Self::History>) -> u8 {
+        u8::from(state.yielded)
+    }
+
     /// The return map: stress, elastic strain and history from the trial
     /// elastic strain (given spectrally) and the converged history.
     fn return_map(&self, trial: &SymSpectral, history: &Self::History) -> LawState<Self::History>;

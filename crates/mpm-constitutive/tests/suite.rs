@@ -6,4 +6,5 @@
 
 mod behaviour;
 mod incremental;
+mod mohr_coulomb;
 mod tangents;
