@@ -40,6 +40,7 @@
 //! ```
 
 pub mod driver;
+pub mod drucker_prager;
 pub mod error;
 pub mod hencky;
 pub mod incremental;
@@ -59,6 +60,7 @@ pub use driver::{
     ConsistentTangent, MaterialState, PreviouslyConvergedTangent, Response, SpatialTangent,
     TangentParts, update,
 };
+pub use drucker_prager::{DruckerPrager, DruckerPragerHistory, Matching};
 pub use error::{ConstitutiveError, Result};
 pub use hencky::HenckyElastic;
 pub use incremental::{IncrementalLaw, Spectral};

@@ -1,7 +1,6 @@
 //! Mohr–Coulomb elasto-plasticity with linear cohesion hardening and
 //! non-associated flow: the exact multi-surface return in sorted principal
-//! Kirchhoff stresses (de Souza Neto, Perić & Owen 2008, §8.2, Boxes
-//! 8.4–8.5), in Hencky strain by the exponential map.
+//! Kirchhoff stresses (de Souza Neto, Perić & Owen 2008, §8.2), in Hencky strain by the exponential map.
 //!
 //! Stresses are tension-positive and sorted $\tau_1\ge\tau_2\ge\tau_3$. The
 //! six planes of the pyramid reduce, in sorted order, to the main plane
@@ -24,7 +23,7 @@
 //!   associated law does, $\sin\psi \to \sin\phi$; without hardening the
 //!   apex is the same either way).
 //!
-//! The regime is chosen as in Box 8.5: the main plane when its return keeps
+//! The regime is chosen as de Souza Neto et al. do: the main plane when its return keeps
 //! the order; otherwise the edge whose order it breaks first; the apex
 //! when the edge's multipliers are not both non-negative or its order
 //! breaks. At $\phi = 0$ (Tresca) the apex is never formed: $c\cot\phi$

@@ -5,6 +5,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod behaviour;
+mod drucker_prager;
 mod incremental;
 mod mohr_coulomb;
 mod tangents;
