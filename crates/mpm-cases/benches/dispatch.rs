@@ -281,12 +281,7 @@ fn explicit_cube(c: &mut Criterion) {
     use mpm_cases::scene::explicit_law::{ExplicitLaw, ExplicitLaws};
     use mpm_constitutive::MaterialSet;
     use mpm_solver::explicit::verification::{elastic_cube, elastic_cube_with};
-    let params = MaterialParams {
-        youngs_modulus: 1e6,
-        poisson_ratio: 0.3,
-        yield_stress: None,
-        hardening: 0.0,
-    };
+    let params = MaterialParams::elastic(1e6, 0.3);
     let n = 32;
     let law = ExplicitLaw::new(MaterialModel::NeoHookean, &params).unwrap();
     let laws: ExplicitLaws = MaterialSet::new(vec![law]).unwrap();

@@ -311,6 +311,32 @@ acceleration = [0.0, -10.0]
 steps = 2
 "#;
 
+/// The soil laws run from a scene, beside an elastic material: the valid
+/// scene's block as Mohr–Coulomb and as Drucker–Prager under gravity, and
+/// a Hencky layer under a Mohr–Coulomb one.
+#[test]
+fn soil_materials_run_from_a_scene() {
+    let soil =
+        "model = \"mohr_coulomb\"\ncohesion = 1e3\nfriction_angle = 30.0\ndilation_angle = 5.0";
+    let dp =
+        "model = \"drucker_prager\"\nmatching = \"inner\"\ncohesion = 1e3\nfriction_angle = 30.0";
+    for model in [soil, dp] {
+        let text = VALID.replacen("model = \"hencky\"", model, 1);
+        let (_, out) = run2(&text, &[]);
+        assert_eq!(out.summary.steps, 2);
+    }
+    let layered = VALID.replacen(
+        "[[body]]",
+        &format!(
+            "[[material]]\nname = \"soil\"\n{soil}\nyoungs_modulus = 1e6\npoisson_ratio = 0.3\ndensity = 1.0\n\n\
+             [[body]]\nname = \"top\"\nmaterial = \"soil\"\nregion = {{ box = {{ lower = [0.0, 1.0], upper = [2.0, 1.5] }} }}\n\n[[body]]"
+        ),
+        1,
+    );
+    let (_, out) = run2(&layered, &[]);
+    assert_eq!(out.summary.steps, 2);
+}
+
 #[test]
 fn the_valid_scene_builds_and_runs() {
     let (problem, out) = run2(VALID, &[]);
@@ -323,6 +349,51 @@ fn the_valid_scene_builds_and_runs() {
 fn malformed_scenes_are_refused_with_a_located_message() {
     let cases: &[(&str, &str, &str)] = &[
         // (replace this, with this, expect this in the message)
+        (
+            "model = \"hencky\"",
+            "model = \"mohr_coulomb\"\nfriction_angle = 30.0",
+            "bad.toml:7:8: material `m` (mohr_coulomb) needs cohesion",
+        ),
+        (
+            "model = \"hencky\"",
+            "model = \"mohr_coulomb\"\ncohesion = -1.0\nfriction_angle = 30.0",
+            "bad.toml:9:12: material `m`: cohesion must be >= 0 Pa",
+        ),
+        (
+            "model = \"hencky\"",
+            "model = \"drucker_prager\"\nmatching = \"outer\"\ncohesion = 0.0\nfriction_angle = 0.0",
+            "bad.toml:10:12: material `m`: cohesion must be >= 0 Pa, and > 0 when friction_angle = 0",
+        ),
+        (
+            "model = \"hencky\"",
+            "model = \"mohr_coulomb\"\ncohesion = 1.0\nfriction_angle = 95.0",
+            "bad.toml:10:18: material `m`: friction_angle must lie in [0, 90) degrees",
+        ),
+        (
+            "model = \"hencky\"",
+            "model = \"mohr_coulomb\"\ncohesion = 1.0\nfriction_angle = 20.0\ndilation_angle = 25.0",
+            "bad.toml:11:18: material `m`: dilation_angle must lie in [0, friction_angle] degrees",
+        ),
+        (
+            "model = \"hencky\"",
+            "model = \"hencky\"\ncohesion = 1.0",
+            "bad.toml:9:12: material `m`: cohesion applies to model = mohr_coulomb or drucker_prager",
+        ),
+        (
+            "model = \"hencky\"",
+            "model = \"drucker_prager\"\ncohesion = 1.0\nfriction_angle = 30.0",
+            "bad.toml:7:8: material `m` (drucker_prager) needs matching",
+        ),
+        (
+            "model = \"hencky\"",
+            "model = \"mohr_coulomb\"\ncohesion = 1.0\nfriction_angle = 30.0\nmatching = \"outer\"",
+            "bad.toml:11:12: material `m`: matching applies to model = drucker_prager",
+        ),
+        (
+            "model = \"hencky\"",
+            "model = \"drucker_prager\"\ncohesion = 1.0\nfriction_angle = 30.0\nmatching = \"middle\"",
+            "bad.toml:11:12: unknown variant `middle`, expected one of `outer`, `inner`, `plane_strain`",
+        ),
         (
             "cells = [2, 2]",
             "cells = [2, 2]\nspacings = [1.0]",

@@ -93,6 +93,15 @@ impl<L: LogStrainLaw> LogStrainLaw for MaterialSet<L> {
 
     const SYMMETRIC_TANGENT: bool = L::SYMMETRIC_TANGENT;
 
+    /// Symmetric when every member law's tangent is.
+    fn symmetric_tangent(&self) -> bool {
+        self.laws.iter().all(LogStrainLaw::symmetric_tangent)
+    }
+
+    fn regime(&self, state: &LawState<Self::History>) -> u8 {
+        self.law(state.history.material).regime(&untagged(state))
+    }
+
     #[inline(always)]
     fn return_map(&self, trial: &SymSpectral, history: &Self::History) -> LawState<Self::History> {
         let state = self.law(history.material).return_map(trial, &history.inner);

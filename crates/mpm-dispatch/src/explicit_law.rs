@@ -105,6 +105,7 @@ mod tests {
             poisson_ratio: 0.3,
             yield_stress: Some(2e4),
             hardening: 1e4,
+            ..MaterialParams::elastic(2e6, 0.3)
         }
     }
 

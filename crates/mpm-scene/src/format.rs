@@ -9,7 +9,7 @@
 use serde::{Deserialize, Serialize};
 use toml::Spanned;
 
-use crate::material::MaterialModel;
+use crate::material::{ConeMatching, MaterialModel};
 use crate::variant::{BasisKind, DomainUpdateKind, FormulationKind, GimpVolumeKind, LockingKind};
 
 /// A whole problem: mesh, materials, bodies, conditions, loads, solver
@@ -227,9 +227,23 @@ pub struct MaterialSpec {
     /// Yield stress ρ_y (Pa), for `von_mises`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub yield_stress: Option<f64>,
-    /// Linear hardening modulus (Pa), for `von_mises`.
+    /// Linear hardening modulus (Pa): of the yield stress (`von_mises`) or
+    /// of the cohesion (`mohr_coulomb`, `drucker_prager`).
     #[serde(default)]
     pub hardening: f64,
+    /// Cohesion c (Pa), for `mohr_coulomb` and `drucker_prager`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cohesion: Option<Spanned<f64>>,
+    /// Friction angle φ (degrees, in [0, 90)), for the soil laws.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_angle: Option<Spanned<f64>>,
+    /// Dilation angle ψ (degrees, in [0, φ]; default 0), for the soil laws.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dilation_angle: Option<Spanned<f64>>,
+    /// The Drucker–Prager cone's fit to Mohr–Coulomb: `outer`, `inner` or
+    /// `plane_strain`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matching: Option<Spanned<ConeMatching>>,
 }
 
 /// A region of space: a box, a polygon (2D), a sphere or disc, or a union

@@ -14,8 +14,9 @@
 //! `LogStrainLaw`) and one line in the [`register_laws!`] call below.
 
 use mpm_constitutive::{
-    HenckyElastic, IsotropicElasticity, LawState, LogStrainLaw, MaterialSet, NeoHookean,
-    SymSpectral, Tagged, Tensor4, VonMises, VonMisesHistory,
+    DruckerPrager, DruckerPragerHistory, HenckyElastic, IsotropicElasticity, LawState,
+    LogStrainLaw, Matching, MaterialSet, MohrCoulomb, MohrCoulombHistory, NeoHookean, SymSpectral,
+    Tagged, Tensor4, VonMises, VonMisesHistory,
 };
 use mpm_solver::{Flat, SolverError};
 use nalgebra::Vector3;
@@ -29,8 +30,55 @@ pub struct MaterialParams {
     pub poisson_ratio: f64,
     /// Yield stress ρ_y of eq. (16) (Pa), for plastic laws.
     pub yield_stress: Option<f64>,
-    /// Linear isotropic hardening modulus (Pa), for plastic laws.
+    /// Linear isotropic hardening modulus (Pa), for plastic laws: of the
+    /// yield stress (von Mises) or of the cohesion (soil laws).
     pub hardening: f64,
+    /// Cohesion c (Pa), for the soil laws.
+    pub cohesion: Option<f64>,
+    /// Friction angle φ (degrees), for the soil laws.
+    pub friction_angle: Option<f64>,
+    /// Dilation angle ψ (degrees), for the soil laws.
+    pub dilation_angle: f64,
+    /// How the Drucker–Prager cone matches Mohr–Coulomb.
+    pub matching: Option<ConeMatching>,
+}
+
+crate::variant::named_enum!(
+    /// The Drucker–Prager cone's fit to Mohr–Coulomb (`matching`).
+    ConeMatching {
+        /// Through the compression edges (triaxial compression).
+        Outer => "outer",
+        /// Through the extension edges (triaxial extension).
+        Inner => "inner",
+        /// Mohr–Coulomb's plane-strain limit load (associated flow).
+        PlaneStrain => "plane_strain",
+    }
+);
+
+impl From<ConeMatching> for Matching {
+    fn from(m: ConeMatching) -> Self {
+        match m {
+            ConeMatching::Outer => Matching::Outer,
+            ConeMatching::Inner => Matching::Inner,
+            ConeMatching::PlaneStrain => Matching::PlaneStrain,
+        }
+    }
+}
+
+impl MaterialParams {
+    /// Elastic parameters only (the other keys absent).
+    pub fn elastic(youngs_modulus: f64, poisson_ratio: f64) -> Self {
+        Self {
+            youngs_modulus,
+            poisson_ratio,
+            yield_stress: None,
+            hardening: 0.0,
+            cohesion: None,
+            friction_angle: None,
+            dilation_angle: 0.0,
+            matching: None,
+        }
+    }
 }
 
 /// The laws of a scene's materials: material `k` is law `k`, each point's
@@ -212,6 +260,21 @@ macro_rules! register_laws {
                 }
             }
 
+            fn symmetric_tangent(&self) -> bool {
+                match self {
+                    $(SceneLaw::$variant(law) => law.symmetric_tangent(),)+
+                }
+            }
+
+            fn regime(&self, state: &LawState<SceneHistory>) -> u8 {
+                match self {
+                    $(SceneLaw::$variant(law) => {
+                        let (_, s) = inner_state!($variant, &state.history, state);
+                        law.regime(&s)
+                    })+
+                }
+            }
+
             #[inline]
             fn point_shear_modulus(&self, history: &SceneHistory) -> Option<f64> {
                 match self {
@@ -276,6 +339,27 @@ pub fn scene_laws(materials: &[(MaterialModel, MaterialParams)]) -> Result<Scene
     Ok(MaterialSet::new(laws)?)
 }
 
+/// A soil law's $(c, \phi, \psi)$, or an error naming the missing key.
+fn strength(p: &MaterialParams, model: &str) -> Result<(f64, f64, f64), SolverError> {
+    let need = |v: Option<f64>, key: &str| {
+        v.ok_or_else(|| SolverError::InvalidInput(format!("material = {model} needs {key}")))
+    };
+    Ok((
+        need(p.cohesion, "cohesion")?,
+        need(p.friction_angle, "friction_angle")?,
+        p.dilation_angle,
+    ))
+}
+
+/// The Drucker–Prager matching, or an error asking for it.
+fn matching(p: &MaterialParams) -> Result<Matching, SolverError> {
+    p.matching.map(Matching::from).ok_or_else(|| {
+        SolverError::InvalidInput(
+            "material = drucker_prager needs matching (outer, inner or plane_strain)".into(),
+        )
+    })
+}
+
 /// The yield stress of a plastic model, or an error naming the model.
 fn yield_stress(p: &MaterialParams, model: &str) -> Result<f64, SolverError> {
     p.yield_stress
@@ -293,6 +377,21 @@ register_laws! {
         p.poisson_ratio,
         yield_stress(p, "von_mises")?,
         p.hardening,
+    );
+    /// Mohr–Coulomb with cohesion hardening and non-associated flow (de
+    /// Souza Neto et al. 2008 §8.2).
+    MohrCoulomb => "mohr_coulomb", MohrCoulomb, |p| {
+        let (c, phi, psi) = strength(p, "mohr_coulomb")?;
+        MohrCoulomb::new(p.youngs_modulus, p.poisson_ratio, c, phi, psi, p.hardening)
+    };
+    /// Drucker–Prager matched to Mohr–Coulomb (de Souza Neto et al. 2008
+    /// §8.3).
+    DruckerPrager => "drucker_prager", DruckerPrager, |p| DruckerPrager::new(
+        p.youngs_modulus,
+        p.poisson_ratio,
+        strength(p, "drucker_prager")?,
+        p.hardening,
+        matching(p)?,
     );
 }
 
@@ -320,6 +419,20 @@ impl HistoryOutput for VonMisesHistory {
     }
 }
 
+/// The soil laws' hardening variable $\alpha$, de Souza Neto et al.'s
+/// accumulated plastic strain $\bar\varepsilon^p$ of each law.
+impl HistoryOutput for MohrCoulombHistory {
+    fn equivalent_plastic_strain(&self) -> f64 {
+        self.alpha
+    }
+}
+
+impl HistoryOutput for DruckerPragerHistory {
+    fn equivalent_plastic_strain(&self) -> f64 {
+        self.alpha
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -331,6 +444,7 @@ mod tests {
             poisson_ratio: 0.3,
             yield_stress,
             hardening: 2e4,
+            ..MaterialParams::elastic(1e6, 0.3)
         }
     }
 
@@ -341,13 +455,31 @@ mod tests {
             match SceneLaw::new(*model, &p) {
                 Ok(law) => assert_eq!(law.model(), *model),
                 Err(e) => {
-                    assert_eq!(*model, MaterialModel::VonMises);
-                    assert!(e.to_string().contains("needs yield_stress"), "{e}");
+                    let needs = match model {
+                        MaterialModel::VonMises => "needs yield_stress",
+                        MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager => {
+                            "needs cohesion"
+                        }
+                        _ => panic!("{model}: {e}"),
+                    };
+                    assert!(e.to_string().contains(needs), "{e}");
                 }
             }
         }
         p.yield_stress = Some(1e3);
         assert!(SceneLaw::new(MaterialModel::VonMises, &p).is_ok());
+        (p.cohesion, p.friction_angle) = (Some(1e3), Some(30.0));
+        assert!(SceneLaw::new(MaterialModel::MohrCoulomb, &p).is_ok());
+        let e = SceneLaw::new(MaterialModel::DruckerPrager, &p).expect_err("no matching");
+        assert!(e.to_string().contains("needs matching"), "{e}");
+        p.matching = Some(ConeMatching::PlaneStrain);
+        assert!(SceneLaw::new(MaterialModel::DruckerPrager, &p).is_ok());
+        p.dilation_angle = 40.0;
+        assert!(matches!(
+            SceneLaw::new(MaterialModel::MohrCoulomb, &p),
+            Err(SolverError::Material(_))
+        ));
+        p.dilation_angle = 0.0;
         p.poisson_ratio = 0.5;
         assert!(matches!(
             SceneLaw::new(MaterialModel::Hencky, &p),

@@ -57,7 +57,7 @@ use crate::format::{
     MeshSpec, MotionKind, MotionSpec, NodeSetSpec, OutputSpec, Placement, RegionSpec, Scene,
     SolverKind, SolverSpec, default_points_per_cell,
 };
-use crate::material::MaterialModel;
+use crate::material::{ConeMatching, MaterialModel};
 use crate::variant::Variant;
 
 /// `v` as a typed scene holds it: with the empty span `0..0`, at no place
@@ -249,7 +249,31 @@ impl MaterialSpec {
             yield_stress: None,
             // `#[serde(default)]`: the type's default.
             hardening: Default::default(),
+            cohesion: None,
+            friction_angle: None,
+            dilation_angle: None,
+            matching: None,
         }
+    }
+
+    /// Sets the soil laws' cohesion (Pa), friction and dilation angles
+    /// (degrees).
+    pub fn with_strength(
+        mut self,
+        cohesion: f64,
+        friction_angle: f64,
+        dilation_angle: f64,
+    ) -> Self {
+        self.cohesion = Some(value(cohesion));
+        self.friction_angle = Some(value(friction_angle));
+        self.dilation_angle = Some(value(dilation_angle));
+        self
+    }
+
+    /// Sets the Drucker–Prager `matching`.
+    pub fn with_matching(mut self, matching: ConeMatching) -> Self {
+        self.matching = Some(value(matching));
+        self
     }
 
     /// Sets `yield_stress` (Pa).

@@ -9,7 +9,9 @@
 //! [`MaterialPoints::from_flat`]).
 
 use mpm_basis::Corners;
-use mpm_constitutive::{MaterialState, Tagged, VonMisesHistory};
+use mpm_constitutive::{
+    DruckerPragerHistory, MaterialState, MohrCoulombHistory, Regime, Tagged, VonMisesHistory,
+};
 use nalgebra::{Matrix3, SVector};
 
 use crate::error::SolverError;
@@ -71,6 +73,28 @@ impl Flat for VonMisesHistory {
         VonMisesHistory { alpha: from[0] }
     }
 }
+
+/// A soil law's history: the hardening variable and the regime's code.
+macro_rules! flat_soil_history {
+    ($($ty:ty),+) => {$(
+        impl Flat for $ty {
+            const LEN: usize = 2;
+            fn write(&self, out: &mut Vec<f64>) {
+                out.push(self.alpha);
+                out.push(f64::from(self.regime as u8));
+            }
+            fn read(from: &[f64]) -> Self {
+                Self {
+                    alpha: from[0],
+                    // Codes 0..=4 only (written above).
+                    regime: Regime::from_code(from[1] as u8),
+                }
+            }
+        }
+    )+};
+}
+
+flat_soil_history!(MohrCoulombHistory, DruckerPragerHistory);
 
 impl<const D: usize> Flat for Corners<D> {
     const LEN: usize = D << D;

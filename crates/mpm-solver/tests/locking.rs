@@ -10,7 +10,7 @@
 use super::common;
 
 use mpm_basis::{BasisFunction, Gimp, LinearMpm, LinearSimplex};
-use mpm_constitutive::{HenckyElastic, LogStrainLaw, VonMises};
+use mpm_constitutive::{HenckyElastic, LogStrainLaw, MohrCoulomb, VonMises};
 use mpm_mesh::{BoxMesh, PatchMesh, RegularGrid, SimplexMesh, SplitMix64};
 use mpm_solver::{
     FBar, FPatch, FirstTangent, Formulation, GhostPenalty, ImplicitSolver, LoadStepping,
@@ -261,6 +261,12 @@ fn plastic() -> VonMises {
     VonMises::new(1e5, 0.45, 2e2, 1e3).unwrap()
 }
 
+/// Pressure-dependent, non-associated and hardening (c = 200 against
+/// stresses of order 1e3).
+fn soil() -> MohrCoulomb {
+    MohrCoulomb::new(1e5, 0.45, 2e2, 30.0, 10.0, 1e3).unwrap()
+}
+
 const TOL: f64 = 1e-6;
 
 proptest! {
@@ -277,6 +283,8 @@ proptest! {
             fbar_case::<2, _, PreviouslyConverged, _>(LinearMpm, elastic(), (), cells, seed),
             fbar_case::<2, _, UpdatedLagrangian, _>(LinearMpm, plastic(), (), cells, seed),
             fbar_case::<2, _, PreviouslyConverged, _>(LinearMpm, plastic(), (), cells, seed),
+            fbar_case::<2, _, UpdatedLagrangian, _>(LinearMpm, soil(), (), cells, seed),
+            fbar_case::<2, _, PreviouslyConverged, _>(LinearMpm, soil(), (), cells, seed),
         ] {
             prop_assert!(e <= TOL, "relative error {e:e}");
         }

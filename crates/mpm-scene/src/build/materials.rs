@@ -8,6 +8,7 @@ use crate::SceneError;
 use crate::format::MaterialSpec;
 use crate::material::{MaterialModel, MaterialParams, SceneLaw};
 use crate::source::SceneSource;
+use toml::Spanned;
 
 /// The materials' names (for the bodies' lookups) and the built
 /// materials, in file order; `explicit`: the scene runs the explicit
@@ -37,11 +38,16 @@ pub(super) fn materials(
                 "the explicit solver needs a positive density (the points' masses set the wave speed and the time step)",
             ));
         }
+        check_soil_keys(spec, src)?;
         let mut params = MaterialParams {
             youngs_modulus: spec.youngs_modulus,
             poisson_ratio: spec.poisson_ratio,
             yield_stress: spec.yield_stress,
             hardening: spec.hardening,
+            cohesion: spec.cohesion.as_ref().map(|v| *v.get_ref()),
+            friction_angle: spec.friction_angle.as_ref().map(|v| *v.get_ref()),
+            dilation_angle: spec.dilation_angle.as_ref().map_or(0.0, |v| *v.get_ref()),
+            matching: spec.matching.as_ref().map(|v| *v.get_ref()),
         };
         if spec.model != MaterialModel::VonMises && spec.yield_stress.is_some() {
             return Err(src.at(
@@ -72,11 +78,12 @@ pub(super) fn materials(
         // name laws per material.)
         if let Some(first) = materials.first()
             && first.model != model
+            && !mixes_with_soil(first.model, model)
         {
             return Err(src.at(
                 &spec.name,
                 format!(
-                    "material `{}` is {} but `{}` is {}: the materials of one scene share one model (hencky mixes with von_mises)",
+                    "material `{}` is {} but `{}` is {}: the materials of one scene share one model (hencky mixes with von_mises; mohr_coulomb and drucker_prager with each other and with hencky and neo_hookean)",
                     spec.name.get_ref(),
                     spec.model,
                     first.name,
@@ -92,4 +99,95 @@ pub(super) fn materials(
         });
     }
     Ok((material_names, materials))
+}
+
+/// The soil laws' keys: present where the model needs them, absent
+/// elsewhere, and in range, each error at its key.
+fn check_soil_keys(spec: &MaterialSpec, src: &SceneSource) -> Result<(), SceneError> {
+    let model = spec.model;
+    let soil = matches!(
+        model,
+        MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager
+    );
+    let name = spec.name.get_ref();
+    let keys: [(&str, Option<&Spanned<f64>>); 3] = [
+        ("cohesion", spec.cohesion.as_ref()),
+        ("friction_angle", spec.friction_angle.as_ref()),
+        ("dilation_angle", spec.dilation_angle.as_ref()),
+    ];
+    for (key, value) in keys {
+        match value {
+            Some(v) if !soil => {
+                return Err(src.at(
+                    v,
+                    format!(
+                        "material `{name}`: {key} applies to model = mohr_coulomb or drucker_prager"
+                    ),
+                ));
+            }
+            None if soil && key != "dilation_angle" => {
+                return Err(src.at(
+                    &spec.name,
+                    format!("material `{name}` ({model}) needs {key}"),
+                ));
+            }
+            _ => {}
+        }
+    }
+    if let Some(m) = &spec.matching
+        && model != MaterialModel::DruckerPrager
+    {
+        return Err(src.at(
+            m,
+            format!("material `{name}`: matching applies to model = drucker_prager"),
+        ));
+    }
+    if model == MaterialModel::DruckerPrager && spec.matching.is_none() {
+        return Err(src.at(
+            &spec.name,
+            format!("material `{name}` (drucker_prager) needs matching = \"outer\", \"inner\" or \"plane_strain\""),
+        ));
+    }
+    check_ranges(spec, src)
+}
+
+/// c ≥ 0 (Pa), φ in [0, 90), ψ in [0, φ] (degrees), c > 0 when φ = 0.
+fn check_ranges(spec: &MaterialSpec, src: &SceneSource) -> Result<(), SceneError> {
+    let name = spec.name.get_ref();
+    let phi = spec.friction_angle.as_ref().map(|v| *v.get_ref());
+    if let Some(c) = &spec.cohesion
+        && (*c.get_ref() < 0.0 || (*c.get_ref() == 0.0 && phi == Some(0.0)))
+    {
+        return Err(src.at(
+            c,
+            format!("material `{name}`: cohesion must be >= 0 Pa, and > 0 when friction_angle = 0 (no strength otherwise)"),
+        ));
+    }
+    if let Some(f) = &spec.friction_angle
+        && !(0.0..90.0).contains(f.get_ref())
+    {
+        return Err(src.at(
+            f,
+            format!("material `{name}`: friction_angle must lie in [0, 90) degrees"),
+        ));
+    }
+    if let Some(d) = &spec.dilation_angle
+        && !(*d.get_ref() >= 0.0 && *d.get_ref() <= phi.unwrap_or(0.0))
+    {
+        return Err(src.at(
+            d,
+            format!("material `{name}`: dilation_angle must lie in [0, friction_angle] degrees"),
+        ));
+    }
+    Ok(())
+}
+
+/// Whether two models may share a scene as a soil law beside another soil
+/// law or an elastic one (a footing on soil): the run-time law set holds
+/// both, each point with its own.
+fn mixes_with_soil(a: MaterialModel, b: MaterialModel) -> bool {
+    use MaterialModel::{DruckerPrager, Hencky, MohrCoulomb, NeoHookean};
+    let soil = |m| matches!(m, MohrCoulomb | DruckerPrager);
+    let elastic = |m| matches!(m, Hencky | NeoHookean);
+    (soil(a) && (soil(b) || elastic(b))) || (soil(b) && elastic(a))
 }

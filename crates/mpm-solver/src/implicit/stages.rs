@@ -241,8 +241,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         it.values.clear();
         it.values.resize(sys.row_idx.len(), 0.0);
         it.stiffness_assembled = false;
-        let symmetric =
-            <P::Law as LogStrainLaw>::SYMMETRIC_TANGENT && !self.locking.couples_points();
+        let symmetric = self.law.symmetric_tangent() && !self.locking.couples_points();
         self.analysed = false;
         match &self.ranks {
             Some(link) if self.linear.solves_over_ranks() => {
