@@ -231,13 +231,25 @@ impl DruckerPrager {
         }
     }
 
-    /// Whether an elastic trial lies on the cone to rounding (a state a
-    /// load step starts from after plastic flow).
-    fn on_yield_surface(&self, eps: &Vector3<f64>, history: &DruckerPragerHistory) -> bool {
+    /// The regime for continued loading from an elastic trial: the cone,
+    /// or the apex when the stress sits there, if the trial lies on the
+    /// surface to rounding (a state a load step starts from after plastic
+    /// flow); elastic otherwise.
+    fn loading_regime(&self, eps: &Vector3<f64>, history: &DruckerPragerHistory) -> Regime {
         let (q, _, p) = self.trial_invariants(eps);
         let c = self.cohesion(history);
         let scale = (self.xi * c).max(q).max(p.abs());
-        q > 0.0 && q + self.eta * p - self.xi * c >= -1e-10 * scale
+        if q + self.eta * p - self.xi * c < -1e-10 * scale {
+            Regime::Elastic
+        } else if q <= 1e-10 * scale {
+            if self.eta > 0.0 {
+                Regime::Apex
+            } else {
+                Regime::Elastic
+            }
+        } else {
+            Regime::Plane
+        }
     }
 
     fn tangent_of(
@@ -305,10 +317,10 @@ impl LogStrainLaw for DruckerPrager {
         if state.yielded {
             return self.algorithmic_tangent(trial, history, state);
         }
-        if !self.on_yield_surface(&trial.values, history) {
-            return self.elasticity.stiffness();
+        match self.loading_regime(&trial.values, history) {
+            Regime::Elastic => self.elasticity.stiffness(),
+            regime => self.tangent_of(trial, state, 0.0, regime),
         }
-        self.tangent_of(trial, state, 0.0, Regime::Plane)
     }
 
     fn regime(&self, state: &LawState<DruckerPragerHistory>) -> u8 {

@@ -320,8 +320,8 @@ impl MohrCoulomb {
     }
 
     /// The regime for continued loading from a trial state the return took
-    /// as elastic: the plane (or the edge the stresses sit on) when the
-    /// trial lies on the surface to rounding, elastic otherwise.
+    /// as elastic: the plane (or the edge or apex the stresses sit on) when
+    /// the trial lies on the surface to rounding, elastic otherwise.
     fn loading_regime(&self, eps: &Vector3<f64>, history: &MohrCoulombHistory) -> Regime {
         let sigma = self.elastic() * eps;
         let k = 2.0 * self.cohesion(history) * self.cos_phi;
@@ -331,7 +331,9 @@ impl MohrCoulomb {
             return Regime::Elastic;
         }
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-10 * scale;
-        if close(sigma[0], sigma[1]) {
+        if self.sin_phi > 0.0 && close(sigma[0], sigma[2]) {
+            Regime::Apex
+        } else if close(sigma[0], sigma[1]) {
             Regime::CompressionEdge
         } else if close(sigma[1], sigma[2]) {
             Regime::ExtensionEdge

@@ -223,3 +223,36 @@ mpm_constitutive_proptest::law_tangent_properties!(outer_macro, |e, nu| {
 mpm_constitutive_proptest::law_tangent_properties!(plane_strain_macro, |e, nu| {
     DruckerPrager::new(e, nu, (0.05 * e, 20.0, 0.0), 0.1 * e, Matching::PlaneStrain)
 });
+
+/// The loading tangent on the surface (cone and apex) is the one-sided
+/// derivative for continued loading, as for Mohr–Coulomb.
+#[test]
+fn the_loading_tangent_on_the_surface_continues_the_cone_and_the_apex() {
+    let law = DruckerPrager::new(E, NU, (10e3, 30.0, 10.0), 0.05 * E, Matching::Outer).unwrap();
+    for (regime, values) in regime_cases()
+        .into_iter()
+        .filter(|(r, _)| *r != Regime::Elastic)
+    {
+        let eps = rotated(values);
+        let trial = SymSpectral::new(&eps).unwrap();
+        let first = law.return_map(&trial, &DruckerPragerHistory::default());
+        let on = trial.compose(&first.elastic_strain);
+        let on_trial = SymSpectral::new(&on).unwrap();
+        let again = law.return_map(&on_trial, &first.history);
+        assert!(
+            !again.yielded,
+            "{regime:?}: the converged state reads as elastic"
+        );
+        let d = law.loading_tangent(&on_trial, &first.history, &again);
+        let dir = eps / eps.norm();
+        let h = 1e-7;
+        let (tau1, _) = law
+            .kirchhoff_stress(&(on + h * dir), &first.history)
+            .unwrap();
+        let (tau0, _) = law.kirchhoff_stress(&on, &first.history).unwrap();
+        let fd = (tau1 - tau0) / h;
+        let an = mpm_constitutive::tensor::contract(&d, &dir);
+        let err = (an - fd).norm() / fd.norm();
+        assert!(err < 1e-6, "{regime:?}: loading tangent error {err:e}");
+    }
+}

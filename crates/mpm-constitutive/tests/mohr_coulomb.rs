@@ -288,3 +288,40 @@ mpm_constitutive_proptest::law_tangent_properties!(mohr_coulomb_macro, |e, nu| {
 mpm_constitutive_proptest::law_tangent_properties!(tresca_macro, |e, nu| {
     MohrCoulomb::new(e, nu, 0.2 * e, 0.0, 0.0, 0.1 * e)
 });
+
+/// A load step starts from a converged plastic state, which the return
+/// map reads as elastic (on the surface to rounding): the loading tangent
+/// there is the one-sided derivative for continued loading in every
+/// regime. Checked along the increment that led there, to 1e-6.
+#[test]
+fn the_loading_tangent_on_the_surface_continues_each_regime() {
+    let law = MohrCoulomb::new(E, NU, 10e3, 30.0, 10.0, 0.05 * E).unwrap();
+    for (regime, values) in regime_cases()
+        .into_iter()
+        .filter(|(r, _)| *r != Regime::Elastic)
+    {
+        let eps = rotated(values);
+        let h0 = MohrCoulombHistory::default();
+        let first = law.return_map(&SymSpectral::new(&eps).unwrap(), &h0);
+        let trial = SymSpectral::new(&eps).unwrap();
+        let on = trial.compose(&first.elastic_strain);
+        let on_trial = SymSpectral::new(&on).unwrap();
+        let again = law.return_map(&on_trial, &first.history);
+        assert!(
+            !again.yielded,
+            "{regime:?}: the converged state reads as elastic"
+        );
+        let d = law.loading_tangent(&on_trial, &first.history, &again);
+        // Continued loading along the strain path's direction.
+        let dir = eps / eps.norm();
+        let h = 1e-7;
+        let (tau1, _) = law
+            .kirchhoff_stress(&(on + h * dir), &first.history)
+            .unwrap();
+        let (tau0, _) = law.kirchhoff_stress(&on, &first.history).unwrap();
+        let fd = (tau1 - tau0) / h;
+        let an = mpm_constitutive::tensor::contract(&d, &dir);
+        let err = (an - fd).norm() / fd.norm();
+        assert!(err < 1e-6, "{regime:?}: loading tangent error {err:e}");
+    }
+}
