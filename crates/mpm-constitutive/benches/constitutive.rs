@@ -9,8 +9,9 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mpm_constitutive::{
-    ConsistentTangent, HenckyElastic, LogStrainLaw, MaterialState, PreviouslyConvergedTangent,
-    SpatialTangent, SymSpectral, VonMises, VonMisesHistory, update,
+    ConsistentTangent, DruckerPrager, HenckyElastic, LogStrainLaw, Matching, MaterialState,
+    MohrCoulomb, PreviouslyConvergedTangent, Regime, SpatialTangent, SymSpectral, VonMises,
+    VonMisesHistory, update,
 };
 use nalgebra::{Matrix3, Rotation3};
 
@@ -28,6 +29,17 @@ fn bench_law<L: LogStrainLaw>(
     state: MaterialState<L::History>,
 ) {
     let (df, f_n) = inputs();
+    bench_law_at(c, name, law, state, df, f_n);
+}
+
+fn bench_law_at<L: LogStrainLaw>(
+    c: &mut Criterion,
+    name: &str,
+    law: &L,
+    state: MaterialState<L::History>,
+    df: Matrix3<f64>,
+    f_n: Matrix3<f64>,
+) {
     let mut g = c.benchmark_group(name);
     g.bench_function("stress", |b| {
         b.iter(|| update(law, black_box(&df), black_box(&f_n), black_box(&state)).unwrap())
@@ -105,6 +117,8 @@ fn constitutive(c: &mut Criterion) {
         },
     );
 
+    soil(c);
+
     let b = df * be_n * df.transpose();
     let mut g = c.benchmark_group("kinematics");
     g.bench_function("sym_eigen", |bch| {
@@ -113,6 +127,55 @@ fn constitutive(c: &mut Criterion) {
     let s = SymSpectral::new(&b).unwrap();
     g.bench_function("dlog", |bch| bch.iter(|| black_box(&s).dlog().unwrap()));
     g.finish();
+}
+
+/// The soil laws, each regime reached from a prestressed state: $b^e_n =
+/// \exp 2\varepsilon$ with $\varepsilon$ the elastic strain of principal
+/// stresses `sigma` (kPa, E = 10 MPa, ν = 0.3) and a rotation as $\Delta
+/// F$, so the trial stress is `sigma` in a rotated frame (c = 10 kPa,
+/// φ = 30°, ψ = 10°, hardening).
+fn soil(c: &mut Criterion) {
+    let (e, nu) = (1e7, 0.3);
+    let strain = |t: [f64; 3]| {
+        let tr: f64 = t.iter().sum();
+        Matrix3::from_diagonal(&nalgebra::Vector3::from(
+            t.map(|s| ((1.0 + nu) * s - nu * tr) * 1e3 / e),
+        ))
+    };
+    let r = Rotation3::from_euler_angles(0.3, -0.7, 1.1).into_inner();
+    let f_n = Matrix3::identity();
+    let mc = MohrCoulomb::new(e, nu, 1e4, 30.0, 10.0, 0.05 * e).unwrap();
+    let dp = DruckerPrager::new(e, nu, (1e4, 30.0, 10.0), 0.05 * e, Matching::Outer).unwrap();
+    let cases = [
+        ("plane", Regime::Plane, [-50.0, -120.0, -400.0]),
+        ("edge", Regime::CompressionEdge, [-100.0, -100.0, -500.0]),
+        ("apex", Regime::Apex, [60.0, 50.0, 40.0]),
+    ];
+    for (name, regime, sigma) in cases {
+        let be = SymSpectral::new(&(2.0 * strain(sigma))).unwrap().exp();
+        let state = MaterialState {
+            be,
+            history: Default::default(),
+        };
+        let check = update(&mc, &r, &f_n, &state).unwrap();
+        assert_eq!(
+            check.law_state.history.regime, regime,
+            "mohr_coulomb {name}"
+        );
+        bench_law_at(c, &format!("mohr_coulomb_{name}"), &mc, state, r, f_n);
+        if regime != Regime::CompressionEdge {
+            let state = MaterialState {
+                be,
+                history: Default::default(),
+            };
+            let check = update(&dp, &r, &f_n, &state).unwrap();
+            assert_eq!(
+                check.law_state.history.regime, regime,
+                "drucker_prager {name}"
+            );
+            bench_law_at(c, &format!("drucker_prager_{name}"), &dp, state, r, f_n);
+        }
+    }
 }
 
 criterion_group!(benches, constitutive);

@@ -14,6 +14,7 @@
 mod extreme;
 mod rotation;
 mod scenarios;
+mod soil;
 
 use std::fmt::Write as _;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -457,19 +458,20 @@ pub fn matrix(mode: Mode) -> Vec<Row> {
 
 /// What builds each family's rows, in page order (the families are
 /// independent: the test runs them side by side).
-const FAMILY_RUNS: [fn(Mode) -> Vec<Row>; 8] = [
+const FAMILY_RUNS: [fn(Mode) -> Vec<Row>; 9] = [
     scenarios::locking,
     scenarios::contrast,
     scenarios::step_size,
     rotation::rows,
     extreme::rows,
+    soil::rows,
     scenarios::failures,
     scenarios::explicit,
     |_| scenarios::meshes(),
 ];
 
 /// The families in page order, with their introductions.
-const FAMILIES: [(&str, &str); 8] = [
+const FAMILIES: [(&str, &str); 9] = [
     (
         "locking",
         "ν ∈ {0.3, 0.49, 0.4999} × locking treatment × formulation on the cases with references: the column (eq. 42 error against σ_zz = −ϱ₀g(l₀ − Z), which holds for any ν in uniaxial strain), Cook's membrane (small load, linear response; the tip displacement scaled to a load of 100) and the Prandtl footing (error = plateau pressure / ((2 + π)k) − 1). Cook's membrane and the footing run the previously converged formulation (`mpm_cases::locking`).",
@@ -489,6 +491,10 @@ const FAMILIES: [(&str, &str); 8] = [
     (
         "extreme",
         "Principal stretches 0.05 and 20 in the constitutive driver (stress finite, consistent tangents against finite differences: `mpm_constitutive::verification`) and in a one-cell case stretched or compressed by a moving mesh.",
+    ),
+    (
+        "soil",
+        "The soil laws (issue 43): the Mohr–Coulomb strip footing of `scenes/footing_mohr_coulomb.toml` (error: q/c against Prandtl–Reissner's N_c, 14.835 at φ = 20°, 2 + π at φ = 0, on a coarse grid) with φ → 0, associated against non-associated flow and 10× steps; a laterally confined block pulled apart to the apex in tension (error: the top traction against c cot φ).",
     ),
     (
         "failure",
