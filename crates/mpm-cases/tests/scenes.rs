@@ -337,6 +337,100 @@ fn soil_materials_run_from_a_scene() {
     assert_eq!(out.summary.steps, 2);
 }
 
+/// A geostatic column of Mohr–Coulomb soil (issue 43, "Initial stress"):
+/// 10 m of cohesionless soil (φ = 30°, K0 = 1 − sin φ = 0.5, γ = ϱ₀g =
+/// 19 620 N/m³) started from σ_v = −γz, σ_h = K0σ_v with its full weight
+/// from the first step (a flat load curve). The discrete weak form is
+/// integrated exactly (a linear stress against the linear basis, two
+/// points per cell and axis), so the column starts in equilibrium: it
+/// moves less than 1e-6 H in its step and keeps its stresses to 1e-8 γH.
+/// A K0 that puts the column beyond yield is refused at its key.
+const GEOSTATIC: &str = r#"[mesh]
+origin = [0.0, 0.0]
+size = [1.0, 10.5]
+spacing = [0.5, 0.5]
+
+[[material]]
+name = "soil"
+model = "mohr_coulomb"
+youngs_modulus = 2.0e7
+poisson_ratio = 0.3
+density = 2000.0
+cohesion = 0.0
+friction_angle = 30.0
+
+[[body]]
+name = "soil"
+material = "soil"
+region = { box = { lower = [0.0, 0.0], upper = [1.0, 10.0] } }
+points_per_cell = 2
+initial_stress = { kind = "geostatic", surface = 10.0, unit_weight = 19620.0, k0 = 0.5 }
+
+[[curve]]
+name = "full"
+points = [[0.0, 1.0], [1.0, 1.0]]
+
+[[boundary]]
+set = "x_min"
+kind = "roller"
+
+[[boundary]]
+set = "x_max"
+kind = "roller"
+
+[[boundary]]
+set = "y_min"
+kind = "fixed"
+
+[[load]]
+kind = "gravity"
+acceleration = [0.0, -9.81]
+curve = "full"
+
+[solver]
+steps = 1
+"#;
+
+#[test]
+fn a_geostatic_column_starts_in_equilibrium() {
+    let (gamma, height, k0) = (19_620.0, 10.0, 0.5);
+    let (problem, out) = run2(GEOSTATIC, &[]);
+    let last = &out.last;
+    let moved = last
+        .displacement
+        .iter()
+        .map(|u| u[0].hypot(u[1]))
+        .fold(0.0, f64::max);
+    assert!(moved < 1e-6 * height, "moved {moved:e} m");
+    let mut worst: f64 = 0.0;
+    for (p, x) in problem.position.iter().enumerate() {
+        let v = -gamma * (height - x[1]);
+        let s = &last.sigma[p];
+        let err = [(s[4], v), (s[0], k0 * v), (s[8], k0 * v), (s[1], 0.0)]
+            .iter()
+            .map(|(got, want)| (got - want).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            err <= 1e-8 * gamma * height,
+            "point {p} at {x:?}: {s:?} against σ_v = {v}"
+        );
+        worst = worst.max(err / (gamma * height));
+    }
+    println!("geostatic column: moved {moved:.2e} m, stresses within {worst:.2e} γH");
+    let refused = refusal(&GEOSTATIC.replace("k0 = 0.5", "k0 = 0.2"));
+    assert!(
+        refused.contains("bad.toml:20:18: initial_stress of body `soil` lies beyond the yield surface of material `soil`"),
+        "{refused}"
+    );
+    let refused = refusal(&GEOSTATIC.replace("k0 = 0.5", "k0 = -1.0"));
+    assert!(
+        refused.contains("bad.toml:20:18: initial_stress: `k0` must be > 0"),
+        "{refused}"
+    );
+    let refused = refusal(&GEOSTATIC.replace("k0 = 0.5", "k0 = 0.5, depth = 1.0"));
+    assert!(refused.contains("unknown field `depth`"), "{refused}");
+}
+
 #[test]
 fn the_valid_scene_builds_and_runs() {
     let (problem, out) = run2(VALID, &[]);

@@ -671,6 +671,11 @@ where
     for (state, &m) in points.material.iter_mut().zip(&problem.material_of_point) {
         *state = L::State::for_material(m);
     }
+    for (state, be) in points.material.iter_mut().zip(&problem.initial_be) {
+        *state.elastic_left_cauchy_green().ok_or_else(|| {
+            SolverError::InvalidInput("this law's state cannot start from an initial stress".into())
+        })? = *be;
+    }
     if points.mass.len() != points.len() || points.velocity.len() != points.len() {
         return Err(SolverError::InvalidInput(format!(
             "{} points but {} masses and {} velocities",
@@ -1098,6 +1103,11 @@ pub trait FlatState: Copy + Default + Send + Sync + std::fmt::Debug + PartialEq 
     fn material(&self) -> u32 {
         0
     }
+    /// The elastic left Cauchy–Green tensor of a law's state, to start it
+    /// from an initial stress (`None`: the state has none).
+    fn elastic_left_cauchy_green(&mut self) -> Option<&mut Matrix3<f64>> {
+        None
+    }
 }
 
 /// A [`MaterialSet`]'s state: the material index, then the law's state.
@@ -1127,6 +1137,9 @@ impl<S: FlatState> FlatState for Tagged<S> {
     fn material(&self) -> u32 {
         self.material
     }
+    fn elastic_left_cauchy_green(&mut self) -> Option<&mut Matrix3<f64>> {
+        self.inner.elastic_left_cauchy_green()
+    }
 }
 
 impl<H> FlatState for MaterialState<H>
@@ -1146,6 +1159,9 @@ where
     }
     fn plastic_strain(&self) -> f64 {
         self.history.equivalent_plastic_strain()
+    }
+    fn elastic_left_cauchy_green(&mut self) -> Option<&mut Matrix3<f64>> {
+        Some(&mut self.be)
     }
 }
 

@@ -230,6 +230,9 @@ where
         })?;
         *h = Tagged::new(m, law.initial_history());
     }
+    if !p.initial_be.is_empty() {
+        points.be.clone_from(&p.initial_be);
+    }
     points.body_force.clone_from(&p.body_force);
     points.point_force.clone_from(&p.point_forces);
     if !p.curved.is_empty() || !p.manufactured.is_empty() {

@@ -306,6 +306,32 @@ pub struct BodySpec {
     /// default at rest).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub velocity: Option<Spanned<Vec<f64>>>,
+    /// The stress the body's points start from (Pa, compression
+    /// negative): geostatic or isotropic. Default: stress-free.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_stress: Option<Spanned<InitialStressSpec>>,
+}
+
+/// `initial_stress` of a `[[body]]`.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum InitialStressSpec {
+    /// σ_v = −γ (surface − x_v) below the surface (zero above), the
+    /// vertical axis the last one (y in 2D, z in 3D); σ_h = K0 σ_v on the
+    /// other axes, the out-of-plane one of plane strain included.
+    Geostatic {
+        /// The surface's height on the vertical axis (m).
+        surface: f64,
+        /// Unit weight γ = ϱ₀ g (N/m³).
+        unit_weight: f64,
+        /// Coefficient of lateral earth pressure K0 > 0.
+        k0: f64,
+    },
+    /// σ = −p 1.
+    Isotropic {
+        /// Pressure p (Pa, compression positive).
+        pressure: f64,
+    },
 }
 
 /// Placement of a body's points.

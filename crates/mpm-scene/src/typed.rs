@@ -316,6 +316,7 @@ impl BodySpec {
             placement: None,
             lattice_origin: None,
             velocity: None,
+            initial_stress: None,
         }
     }
 

@@ -19,6 +19,7 @@ mod conditions;
 mod curves;
 mod explicit_keys;
 mod explicit_run;
+mod initial_stress;
 mod loads;
 mod materials;
 mod mesh;
@@ -374,6 +375,9 @@ pub struct Problem<const D: usize> {
     pub body_of_point: Vec<u32>,
     /// Dirichlet conditions.
     pub constraints: SceneConstraints<D>,
+    /// The elastic left Cauchy–Green tensor every point starts from, from
+    /// its body's `initial_stress` (empty: every point stress-free).
+    pub initial_be: Vec<nalgebra::Matrix3<f64>>,
     /// Proportional body force per point (empty if none).
     pub body_force: Vec<SVector<f64, D>>,
     /// Proportional point forces.
@@ -621,6 +625,7 @@ impl<const D: usize> Problem<D> {
             explicit,
             src,
         )?;
+        let initial_be = initial_stress::initial_be(&scene.bodies, &bodies, &materials, src)?;
         let sets = node_sets::node_sets(&scene.node_sets, &mesh, &bodies, src)?;
         let conditions = conditions::conditions(scene, &mesh, &sets, &curves, explicit, src)?;
         let loads = loads::loads(
@@ -660,6 +665,7 @@ impl<const D: usize> Problem<D> {
             material_of_point: points.material,
             body_of_point: points.body,
             constraints: conditions.constraints,
+            initial_be,
             body_force: loads.body_force,
             point_forces: loads.point_forces,
             curved: loads.curved,
