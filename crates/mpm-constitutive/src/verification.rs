@@ -408,3 +408,40 @@ pub fn check_algorithmic_tangent<L: LogStrainLaw>(
     )?;
     Ok(fd.map(|fd| relative_error(&d, &fd)))
 }
+
+/// The loading tangent ([`LogStrainLaw::loading_tangent`]) where a load
+/// step starts: at the converged state of the plastic step from the trial
+/// strain `eps` (its elastic strain re-read as a trial, which the return
+/// map takes as elastic, on the surface to rounding), against the
+/// one-sided difference $(\tau(\varepsilon + h d) - \tau(\varepsilon))/h$
+/// along the direction $d$ of `eps` (continued loading), $h$ = `step`.
+///
+/// Returns the relative error of $D : d$, or `None` when the step from
+/// `eps` is elastic or its converged state reads as plastic again.
+pub fn check_loading_tangent<L: LogStrainLaw>(
+    law: &L,
+    eps: &Matrix3<f64>,
+    history: &L::History,
+    step: f64,
+) -> Result<Option<f64>> {
+    require_step(step)?;
+    let trial = SymSpectral::new(eps)?;
+    let first = law.return_map(&trial, history);
+    if !first.yielded {
+        return Ok(None);
+    }
+    let on = trial.compose(&first.elastic_strain);
+    let on_trial = SymSpectral::new(&on)?;
+    let again = law.return_map(&on_trial, &first.history);
+    if again.yielded {
+        return Ok(None);
+    }
+    let d = law.loading_tangent(&on_trial, &first.history, &again);
+    let dir = eps / eps.norm();
+    let (ahead, _) = law.kirchhoff_stress(&(on + step * dir), &first.history)?;
+    let (here, _) = law.kirchhoff_stress(&on, &first.history)?;
+    let fd = (ahead - here) / step;
+    Ok(Some(
+        (crate::tensor::contract(&d, &dir) - fd).norm() / fd.norm(),
+    ))
+}
