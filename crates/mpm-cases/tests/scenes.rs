@@ -281,6 +281,37 @@ fn slope_runs_with_its_curves_and_writes_png_and_vtu() {
     assert!((base - reaction).abs() < 1e-9 * reaction);
 }
 
+/// The soil scenes through `mpm`. The footing (issue 43, "Bearing
+/// capacity", on the coarsest grid that resolves the footing: 4 cells
+/// under the half-width): q/c within 5 % of Prandtl–Reissner's N_c =
+/// 14.835 at φ = 20°. The biaxial test: the platen's pressure rises from
+/// the initial 100 kPa and stays below the plane-strain limit 300 kPa that
+/// the `plane_strain` matching shares with Mohr–Coulomb.
+#[test]
+fn the_soil_scenes_meet_their_limits() {
+    let reaction = |dir: &std::path::Path, name: &str| {
+        let text = std::fs::read_to_string(dir.join(format!("reaction_{name}.csv"))).unwrap();
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap())
+            .collect::<Vec<_>>()
+    };
+    let dir = run_mpm("footing_mohr_coulomb.toml", "soil_footing");
+    let q = -reaction(&dir, "footing").last().copied().unwrap() / 1.0e4;
+    let n_c = 14.835;
+    println!("footing: q/c = {q:.3} against N_c = {n_c}");
+    assert!((q - n_c).abs() <= 0.05 * n_c, "q/c = {q}");
+    let dir = run_mpm("biaxial_drucker_prager.toml", "soil_biaxial");
+    let p: Vec<f64> = reaction(&dir, "platen").iter().map(|r| -r).collect();
+    println!(
+        "biaxial: platen pressure {:.0} → {:.0} Pa",
+        p[0],
+        p[p.len() - 1]
+    );
+    assert!(p[0] > 1.0e5 && p.windows(2).all(|w| w[1] > w[0]), "{p:?}");
+    assert!(p[p.len() - 1] < 3.0e5, "{p:?}");
+}
+
 /// A minimal valid 2D scene, mutated by the table below.
 const VALID: &str = r#"[mesh]
 origin = [0.0, 0.0]
@@ -345,51 +376,7 @@ fn soil_materials_run_from_a_scene() {
 /// points per cell and axis), so the column starts in equilibrium: it
 /// moves less than 1e-6 H in its step and keeps its stresses to 1e-8 γH.
 /// A K0 that puts the column beyond yield is refused at its key.
-const GEOSTATIC: &str = r#"[mesh]
-origin = [0.0, 0.0]
-size = [1.0, 10.5]
-spacing = [0.5, 0.5]
-
-[[material]]
-name = "soil"
-model = "mohr_coulomb"
-youngs_modulus = 2.0e7
-poisson_ratio = 0.3
-density = 2000.0
-cohesion = 0.0
-friction_angle = 30.0
-
-[[body]]
-name = "soil"
-material = "soil"
-region = { box = { lower = [0.0, 0.0], upper = [1.0, 10.0] } }
-points_per_cell = 2
-initial_stress = { kind = "geostatic", surface = 10.0, unit_weight = 19620.0, k0 = 0.5 }
-
-[[curve]]
-name = "full"
-points = [[0.0, 1.0], [1.0, 1.0]]
-
-[[boundary]]
-set = "x_min"
-kind = "roller"
-
-[[boundary]]
-set = "x_max"
-kind = "roller"
-
-[[boundary]]
-set = "y_min"
-kind = "fixed"
-
-[[load]]
-kind = "gravity"
-acceleration = [0.0, -9.81]
-curve = "full"
-
-[solver]
-steps = 1
-"#;
+const GEOSTATIC: &str = include_str!("../../../scenes/geostatic_column.toml");
 
 #[test]
 fn a_geostatic_column_starts_in_equilibrium() {
@@ -419,12 +406,12 @@ fn a_geostatic_column_starts_in_equilibrium() {
     println!("geostatic column: moved {moved:.2e} m, stresses within {worst:.2e} γH");
     let refused = refusal(&GEOSTATIC.replace("k0 = 0.5", "k0 = 0.2"));
     assert!(
-        refused.contains("bad.toml:20:18: initial_stress of body `soil` lies beyond the yield surface of material `soil`"),
+        refused.contains("bad.toml:29:18: initial_stress of body `soil` lies beyond the yield surface of material `soil`"),
         "{refused}"
     );
     let refused = refusal(&GEOSTATIC.replace("k0 = 0.5", "k0 = -1.0"));
     assert!(
-        refused.contains("bad.toml:20:18: initial_stress: `k0` must be > 0"),
+        refused.contains("bad.toml:29:18: initial_stress: `k0` must be > 0"),
         "{refused}"
     );
     let refused = refusal(&GEOSTATIC.replace("k0 = 0.5", "k0 = 0.5, depth = 1.0"));
@@ -1132,6 +1119,9 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/explicit_disks.toml"),
         include_str!("../../../scenes/explicit_cube.toml"),
         include_str!("../../../scenes/explicit_collapse.toml"),
+        include_str!("../../../scenes/footing_mohr_coulomb.toml"),
+        include_str!("../../../scenes/biaxial_drucker_prager.toml"),
+        GEOSTATIC,
     ]
     .join("\n");
     let mut keys = Vec::new();
