@@ -312,6 +312,36 @@ fn the_soil_scenes_meet_their_limits() {
     assert!(p[p.len() - 1] < 3.0e5, "{p:?}");
 }
 
+/// Mohr–Coulomb at φ = 0 is Tresca, whose plane-strain limit load with
+/// cohesion c is von Mises' with k = ρ_y/√2 = c (both reduce to τ1 − τ3 =
+/// 2c in the plane of flow, Prandtl's (2 + π)c): the footing scene run
+/// with each gives one footing pressure at collapse, to 1e-3 (the laws
+/// differ only through the out-of-plane stress of the points not yet at
+/// the limit). Measured on the scene's 0.25 m grid: 5.4917 c with both
+/// (5e-6 apart), +6.8 % of 2 + π, +3.3 % on a 0.125 m grid (the F-bar
+/// excess halving with the spacing, as in the locking study).
+#[test]
+fn tresca_and_von_mises_footings_collapse_at_one_pressure() {
+    let scene = include_str!("../../../scenes/footing_mohr_coulomb.toml");
+    let tresca = scene.replace("friction_angle = 20.0", "friction_angle = 0.0");
+    let von_mises = scene
+        .replace("model = \"mohr_coulomb\"", "model = \"von_mises\"")
+        .replace(
+            "cohesion = 1.0e4\nfriction_angle = 20.0\ndilation_angle = 0.0",
+            "yield_stress = 14142.135623730951",
+        );
+    let pressure = |text: &str| {
+        let (problem, out) = run2(text, &[]);
+        let footing = problem.reactions[0].clone();
+        -footing.total(out.reports.last().unwrap())[1] / 1.0e4
+    };
+    let (t, v) = (pressure(&tresca), pressure(&von_mises));
+    println!("footing at φ = 0: Tresca {t:.5} c, von Mises {v:.5} c");
+    assert!((t - v).abs() <= 1e-3 * v, "Tresca {t}, von Mises {v}");
+    let prandtl = 2.0 + std::f64::consts::PI;
+    assert!(t > prandtl && t < 1.1 * prandtl, "{t}");
+}
+
 /// A minimal valid 2D scene, mutated by the table below.
 const VALID: &str = r#"[mesh]
 origin = [0.0, 0.0]
