@@ -308,3 +308,34 @@ fn the_loading_tangent_on_the_surface_continues_each_regime() {
         assert!(err < 1e-6, "{regime:?}: loading tangent error {err:e}");
     }
 }
+
+/// Strength reduction by F (Griffiths & Lane 1999): c/F and tan φ/F, the
+/// dilation angle capped at the reduced friction angle. The reduced law
+/// fails in triaxial compression at σ3 N + 2c_f √N with N = (1 + sin
+/// φ_f)/(1 − sin φ_f), to 1e-8; a factor that is not positive and finite
+/// is refused.
+#[test]
+fn a_reduced_law_fails_with_the_reduced_strength() {
+    let (c, phi, factor) = (10.0e3, 30.0f64, 1.5);
+    let law = MohrCoulomb::new(E, NU, c, phi, phi, 0.0)
+        .unwrap()
+        .reduced(factor)
+        .unwrap();
+    let phi_f = (phi.to_radians().tan() / factor).atan();
+    let n = (1.0 + phi_f.sin()) / (1.0 - phi_f.sin());
+    let expected = CONFINING * n - 2.0 * (c / factor) * n.sqrt();
+    let mut point = isotropic(&law, CONFINING);
+    triaxial(&mut point, -2e-4, 200);
+    assert_relative(point.stress[2], expected, 1e-8, "reduced axial stress");
+    // ψ = φ before: associated after, at the reduced angle.
+    assert!(law.symmetric_tangent());
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(
+            MohrCoulomb::new(E, NU, c, phi, 0.0, 0.0)
+                .unwrap()
+                .reduced(bad)
+                .is_err(),
+            "{bad}"
+        );
+    }
+}
