@@ -80,6 +80,8 @@ pub struct DruckerPrager {
     xi: f64,
     eta_bar: f64,
     matching: Matching,
+    /// φ and ψ (degrees), kept for [`DruckerPrager::reduced`].
+    angles: (f64, f64),
 }
 
 impl DruckerPrager {
@@ -107,7 +109,24 @@ impl DruckerPrager {
             xi,
             eta_bar,
             matching,
+            angles: (phi, psi),
         })
+    }
+
+    /// The same law with $c$ and $\tan\phi$ divided by `factor` (strength
+    /// reduction), the dilation angle capped at the reduced friction angle,
+    /// the same matching.
+    pub fn reduced(&self, factor: f64) -> Result<Self> {
+        let (phi, psi) = self.angles;
+        let phi_f = (phi.to_radians().tan() / factor).atan().to_degrees();
+        let el = &self.elasticity;
+        Self::new(
+            el.youngs_modulus(),
+            el.poisson_ratio(),
+            (self.cohesion / factor, phi_f, psi.min(phi_f)),
+            self.hardening / factor,
+            self.matching,
+        )
     }
 
     /// The elastic constants.

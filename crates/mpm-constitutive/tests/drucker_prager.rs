@@ -245,3 +245,23 @@ fn the_loading_tangent_on_the_surface_continues_the_cone_and_the_apex() {
         assert!(err < 1e-6, "{regime:?}: loading tangent error {err:e}");
     }
 }
+
+/// Strength reduction keeps the matching: the outer cone reduced by F
+/// fails in triaxial compression where Mohr–Coulomb with c/F and
+/// atan(tan φ/F) does, to 1e-8.
+#[test]
+fn a_reduced_cone_fails_where_the_reduced_mohr_coulomb_does() {
+    let (c, phi, factor) = (10.0e3, 30.0f64, 1.5);
+    let law = DruckerPrager::new(E, NU, (c, phi, 0.0), 0.0, Matching::Outer)
+        .unwrap()
+        .reduced(factor)
+        .unwrap();
+    let phi_f = (phi.to_radians().tan() / factor).atan();
+    let n = (1.0 + phi_f.sin()) / (1.0 - phi_f.sin());
+    let expected = CONFINING * n - 2.0 * (c / factor) * n.sqrt();
+    let mut point = isotropic(&law, CONFINING);
+    drive(&mut point, -2e-4, 200, false);
+    assert_relative(point.stress[2], expected, 1e-8, "reduced axial stress");
+    assert_eq!(law.matching(), Matching::Outer);
+    assert!(law.reduced(-1.0).is_err());
+}
