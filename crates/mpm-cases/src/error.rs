@@ -69,4 +69,30 @@ pub enum CasesError {
     /// A result file could not be written.
     #[error(transparent)]
     Output(#[from] OutputError),
+    /// A strength-reduction search ended without a factor that held and
+    /// one that failed.
+    #[error("strength_reduction: {}", no_bracket(*.held, *.failed, *.trials))]
+    NoBracket {
+        /// The largest factor that held, if any.
+        held: Option<f64>,
+        /// The smallest factor that failed, if any.
+        failed: Option<f64>,
+        /// Trials run.
+        trials: usize,
+    },
+}
+
+/// The message of [`CasesError::NoBracket`].
+fn no_bracket(held: Option<f64>, failed: Option<f64>, trials: usize) -> String {
+    match (held, failed) {
+        (None, Some(f)) => format!(
+            "every factor tried failed, down to {f} in {trials} trials; does the problem hold without reduction (run it without [strength_reduction])?"
+        ),
+        (Some(h), None) => {
+            format!(
+                "every factor tried held, up to {h} in {trials} trials; raise `upper` or `max_trials`"
+            )
+        }
+        _ => format!("no bracket after {trials} trials"),
+    }
 }

@@ -29,6 +29,11 @@ fn run2(text: &str, overrides: &[&str]) -> (Problem<2>, RunOutput<2>) {
 /// Runs `mpm run scenes/<file> --out <fresh dir>`; returns the directory
 /// after checking the program succeeded.
 fn run_mpm(file: &str, test: &str) -> std::path::PathBuf {
+    run_mpm_set(file, test, &[])
+}
+
+/// [`run_mpm`] with `--set` overrides.
+fn run_mpm_set(file: &str, test: &str, set: &[&str]) -> std::path::PathBuf {
     let dir = common::fresh_dir(test);
     let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../scenes")
@@ -38,6 +43,7 @@ fn run_mpm(file: &str, test: &str) -> std::path::PathBuf {
         .arg(scene)
         .arg("--out")
         .arg(&dir)
+        .args(set.iter().flat_map(|s| ["--set", s]))
         .output()
         .unwrap();
     assert!(
@@ -341,6 +347,61 @@ fn tresca_and_von_mises_footings_collapse_at_one_pressure() {
     let prandtl = 2.0 + std::f64::consts::PI;
     assert!(t > prandtl && t < 1.1 * prandtl, "{t}");
 }
+
+/// Griffiths & Lane (1999), example 1 (issue 43, "Slope"): the 2:1 slope
+/// with φ' = 20°, c'/γH = 0.05, ψ = 0 has a factor of safety of 1.4 by
+/// their strength reduction (Bishop & Morgenstern's charts 1.38). On the
+/// scene's 1 m grid the bisection (bracket ≤ 0.01, their non-convergence
+/// criterion) must land in [1.35, 1.45]; a displacement criterion (the
+/// crest moving 0.005 H = 5 cm under gravity) within 0.03 of it; and the
+/// mechanism of the first failed trial must run through the toe: the
+/// points on the face just above the toe and at the crest move with the
+/// sliding mass (more than half its largest step displacement), those
+/// 10 m behind the crest do not (under 5 %).
+#[test]
+fn the_griffiths_lane_slope_has_their_factor_of_safety() {
+    let read = |dir: &std::path::Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+    };
+    let dir = run_mpm("griffiths_lane_slope.toml", "slope_srf");
+    let summary = read(&dir);
+    let sr = &summary["strength_reduction"];
+    let f = |v: &serde_json::Value| v.as_f64().unwrap();
+    let (fos, held, failed) = (
+        f(&sr["factor_of_safety"]),
+        f(&sr["last_held"]),
+        f(&sr["first_failed"]),
+    );
+    println!("slope: F = {fos:.4} in [{held:.4}, {failed:.4}]");
+    assert!((1.35..=1.45).contains(&fos), "{fos}");
+    assert!(failed > held && failed - held <= 0.01, "[{held}, {failed}]");
+    let trials = sr["trials"].as_array().unwrap();
+    let rows = std::fs::read_to_string(dir.join("srf.csv")).unwrap();
+    assert_eq!(rows.lines().count(), trials.len() + 1, "{rows}");
+    let share = &summary["mechanism"]["probe_share"];
+    let (toe, crest, behind) = (f(&share["toe"]), f(&share["crest"]), f(&share["behind"]));
+    println!("mechanism: toe {toe:.3}, crest {crest:.3}, behind {behind:.4}");
+    assert!(toe > 0.5 && crest > 0.5 && behind < 0.05, "{share}");
+    assert!(dir.join("mechanism.png").is_file());
+    let dir = run_mpm_set(
+        "griffiths_lane_slope.toml",
+        "slope_srf_displacement",
+        &SLOPE_BY_DISPLACEMENT,
+    );
+    let by_displacement = f(&read(&dir)["strength_reduction"]["factor_of_safety"]);
+    println!("slope by displacement: F = {by_displacement:.4}");
+    assert!(
+        (by_displacement - fos).abs() <= 0.03,
+        "{by_displacement} against {fos}"
+    );
+}
+
+/// The Griffiths & Lane slope's overrides for the displacement criterion.
+const SLOPE_BY_DISPLACEMENT: [&str; 3] = [
+    "strength_reduction.criterion=displacement",
+    "strength_reduction.probe=crest",
+    "strength_reduction.displacement_limit=0.05",
+];
 
 /// A minimal valid 2D scene, mutated by the table below.
 const VALID: &str = r#"[mesh]
@@ -806,6 +867,46 @@ fn malformed_scenes_are_refused_with_a_located_message() {
             "kind = \"explicit\"\nend_time = 1.0\noutput_interval = 0.0",
             "bad.toml:29:19: solver `output_interval` must be positive, got 0",
         ),
+        (
+            "steps = 2",
+            "steps = 2\n\n[strength_reduction]\nlower = 0.0",
+            "bad.toml:30:9: strength_reduction: `lower` must be finite and > 0, got 0",
+        ),
+        (
+            "steps = 2",
+            "steps = 2\n\n[strength_reduction]\nlower = 2.0\nupper = 1.5",
+            "bad.toml:31:9: strength_reduction: `upper` (1.5) must exceed `lower` (2)",
+        ),
+        (
+            "steps = 2",
+            "steps = 2\n\n[strength_reduction]\nmax_trials = 1",
+            "bad.toml:30:14: strength_reduction: `max_trials` must be in 2..=1000",
+        ),
+        (
+            "steps = 2",
+            "steps = 2\n\n[strength_reduction]\ncriterion = \"displacement\"",
+            "strength_reduction: `criterion = \"displacement\"` needs `probe`",
+        ),
+        (
+            "steps = 2",
+            "steps = 2\n\n[strength_reduction]\ncriterion = \"displacement\"\nprobe = \"nowhere\"\ndisplacement_limit = 0.1",
+            "bad.toml:31:9: strength_reduction: no [[output.probe]] is named `nowhere`",
+        ),
+        (
+            "steps = 2",
+            "steps = 2\n\n[strength_reduction]\ndisplacement_limit = 0.1",
+            "bad.toml:30:22: strength_reduction: `displacement_limit` belongs to `criterion = \"displacement\"`",
+        ),
+        (
+            "steps = 2",
+            "steps = 2\n\n[strength_reduction]\nbisect = true",
+            "unknown field `bisect`",
+        ),
+        (
+            "steps = 2",
+            "kind = \"explicit\"\nend_time = 1.0\n\n[strength_reduction]\nlower = 1.0",
+            "strength_reduction runs the implicit solver",
+        ),
     ];
     let mut wrong = Vec::new();
     for (from, to, expected) in cases {
@@ -1152,6 +1253,11 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/footing_mohr_coulomb.toml"),
         include_str!("../../../scenes/biaxial_drucker_prager.toml"),
         GEOSTATIC,
+        include_str!("../../../scenes/griffiths_lane_slope.toml"),
+        // The displacement criterion's keys, as the slope's test sets them.
+        &SLOPE_BY_DISPLACEMENT
+            .map(|s| s.replace("strength_reduction.", "").replace('=', " = "))
+            .join("\n"),
     ]
     .join("\n");
     let mut keys = Vec::new();

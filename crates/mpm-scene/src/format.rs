@@ -53,6 +53,53 @@ pub struct Scene {
     /// What is written.
     #[serde(default)]
     pub output: OutputSpec,
+    /// A factor of safety by strength reduction: the implicit problem run
+    /// in trials of reduced strength, bisecting for the factor at failure.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub strength_reduction: Option<Spanned<StrengthReductionSpec>>,
+}
+
+crate::variant::named_enum!(
+    /// When a strength-reduction trial has failed (`criterion`).
+    FailureCriterion {
+        /// A load step does not converge after cutting to the minimum
+        /// increment.
+        Convergence => "convergence",
+        /// That, or a probe's displacement beyond `displacement_limit`.
+        Displacement => "displacement",
+    }
+);
+
+/// `[strength_reduction]`: trials of the whole problem with $c$, $\tan\phi$
+/// (and von Mises' yield stress, and the hardening moduli) divided by a
+/// factor $F$, each from the initial state, bisecting between the last
+/// factor that held and the first that failed.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StrengthReductionSpec {
+    /// The first factor tried, expected to hold (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower: Option<Spanned<f64>>,
+    /// The second factor tried, expected to fail (default 2 × `lower`);
+    /// while it holds, the bracket is widened by its width.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upper: Option<Spanned<f64>>,
+    /// The bisection stops when the bracket is this narrow (default 0.01).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<Spanned<f64>>,
+    /// When a trial has failed (default `convergence`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub criterion: Option<Spanned<FailureCriterion>>,
+    /// With `criterion = "displacement"`: the `[[output.probe]]` watched.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe: Option<Spanned<String>>,
+    /// With `criterion = "displacement"`: the probe's displacement
+    /// magnitude (m) beyond which a trial has failed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub displacement_limit: Option<Spanned<f64>>,
+    /// The most trials run (default 30).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_trials: Option<Spanned<usize>>,
 }
 
 /// Kinds of background mesh.

@@ -79,6 +79,25 @@ impl MaterialParams {
             matching: None,
         }
     }
+
+    /// The parameters of a strength-reduction trial at `factor` > 0: the
+    /// cohesion, the yield stress and the hardening modulus divided by it,
+    /// $\phi_F = \arctan(\tan\phi/F)$, the dilation angle capped at
+    /// $\phi_F$ (as `MohrCoulomb::reduced` and `DruckerPrager::reduced`);
+    /// the elastic constants kept.
+    pub fn reduced(&self, factor: f64) -> Self {
+        let phi = self
+            .friction_angle
+            .map(|phi| (phi.to_radians().tan() / factor).atan().to_degrees());
+        Self {
+            yield_stress: self.yield_stress.map(|y| y / factor),
+            hardening: self.hardening / factor,
+            cohesion: self.cohesion.map(|c| c / factor),
+            friction_angle: phi,
+            dilation_angle: phi.map_or(self.dilation_angle, |p| self.dilation_angle.min(p)),
+            ..*self
+        }
+    }
 }
 
 /// The laws of a scene's materials: material `k` is law `k`, each point's
@@ -533,6 +552,53 @@ mod tests {
             }
         }
         assert_eq!(typed.elasticity(), any.elasticity());
+    }
+
+    /// A strength-reduction trial's parameters build the laws' own
+    /// reduced laws (`MohrCoulomb::reduced`, `DruckerPrager::reduced`):
+    /// the same stresses to rounding on a plastic trial strain (the two
+    /// reach φ_F through different roundings of tan φ, 1 ulp apart); von
+    /// Mises' yield stress is divided by the factor.
+    #[test]
+    fn reduced_parameters_build_the_reduced_laws() {
+        let soil = MaterialParams {
+            cohesion: Some(1e4),
+            friction_angle: Some(30.0),
+            dilation_angle: 25.0,
+            matching: Some(ConeMatching::Inner),
+            ..params(None)
+        };
+        let factor = 1.37;
+        let reduced = soil.reduced(factor);
+        let eps = Matrix3::new(-0.02, 0.004, 0.0, 0.004, 0.01, 0.002, 0.0, 0.002, -0.003);
+        let same = |a: SceneLaw, b: SceneLaw| {
+            let h = a.initial_history();
+            let (sa, state) = a.kirchhoff_stress(&eps, &h).expect("stress");
+            let (sb, _) = b.kirchhoff_stress(&eps, &h).expect("stress");
+            assert!(
+                state.yielded && (sa - sb).norm() <= 1e-12 * sa.norm(),
+                "{sa} {sb}"
+            );
+        };
+        let mc = MohrCoulomb::new(1e6, 0.3, 1e4, 30.0, 25.0, 2e4).expect("law");
+        same(
+            SceneLaw::new(MaterialModel::MohrCoulomb, &reduced).expect("law"),
+            SceneLaw::MohrCoulomb(mc.reduced(factor).expect("law")),
+        );
+        let dp =
+            DruckerPrager::new(1e6, 0.3, (1e4, 30.0, 25.0), 2e4, Matching::Inner).expect("law");
+        same(
+            SceneLaw::new(MaterialModel::DruckerPrager, &reduced).expect("law"),
+            SceneLaw::DruckerPrager(dp.reduced(factor).expect("law")),
+        );
+        // φ_F = atan(tan 30° / 1.37) = 22.85° < ψ = 25°: ψ is capped.
+        let phi_f = reduced.friction_angle.expect("reduced angle");
+        assert!((phi_f - 22.852_f64).abs() < 1e-3 && reduced.dilation_angle == phi_f);
+        let vm = params(Some(5e3)).reduced(2.0);
+        assert_eq!(
+            (vm.yield_stress, vm.hardening, vm.youngs_modulus),
+            (Some(2.5e3), 1e4, 1e6)
+        );
     }
 
     #[test]

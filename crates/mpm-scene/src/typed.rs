@@ -88,6 +88,7 @@ impl Scene {
             curves: Vec::new(),
             solver: SolverSpec::default(),
             output: OutputSpec::default(),
+            strength_reduction: None,
         }
     }
 

@@ -62,6 +62,7 @@ pub use mpm_output::png;
 pub use mpm_scene::{SceneError, build, format, region};
 mod program;
 pub mod ranks;
+pub mod strength_reduction;
 
 pub use mpm_dispatch::{
     ExplicitEvent, ExplicitFrame, ExplicitObserver, ExplicitOutput, RunExplicit, RunScene, run,

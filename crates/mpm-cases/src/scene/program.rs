@@ -49,6 +49,14 @@ where
         eprintln!("warning: {}: {w}", source.origin());
     }
     if let Some(shared) = &session.ranks {
+        if let Some(table) = &scene.strength_reduction {
+            return Err(source
+                .at(
+                    table,
+                    "strength_reduction runs on one process: run it without mpirun",
+                )
+                .into());
+        }
         let Some(run) = on_ranks(&problem, session, shared)? else {
             return Ok(());
         };
@@ -87,12 +95,43 @@ where
                 .into()),
         };
     }
+    if let Some(sr) = &problem.strength_reduction {
+        return strength_reduction_on(scene, source, &problem, session, sr);
+    }
     match &problem.mesh {
         crate::scene::build::SceneMesh::Grid(g) => {
             scene_run_on(scene, &problem, session, g.clone(), None)
         }
         crate::scene::build::SceneMesh::Simplex(m) => {
             scene_run_on(scene, &problem, session, (**m).clone(), None)
+        }
+    }
+}
+
+/// The trials of a scene with `[strength_reduction]` on one process.
+fn strength_reduction_on<const D: usize>(
+    scene: &crate::scene::Scene,
+    source: &crate::scene_file::SceneSource,
+    problem: &crate::scene::Problem<D>,
+    session: &Session,
+    sr: &crate::scene::build::StrengthReduction,
+) -> Result<(), CasesError>
+where
+    crate::scene::Problem<D>: crate::scene::RunScene<D>,
+{
+    if session.resume || session.stop_after.is_some() || session.export_tangent {
+        return Err(source
+            .error(
+                None,
+                "strength_reduction: trials restart from the initial state; --resume, --stop-after and --export-tangent do not apply",
+            )
+            .into());
+    }
+    use super::strength_reduction::run;
+    match &problem.mesh {
+        crate::scene::build::SceneMesh::Grid(g) => run(scene, problem, session, g.clone(), sr),
+        crate::scene::build::SceneMesh::Simplex(m) => {
+            run(scene, problem, session, (**m).clone(), sr)
         }
     }
 }
@@ -278,16 +317,37 @@ fn write_png<const D: usize>(
                 .collect(),
         )
     };
+    points_png(
+        problem,
+        "final.png",
+        name,
+        (&last.position, &last.volume),
+        &value,
+        dir,
+    )
+}
+
+/// `dir/file` of the points at `position` with volumes `volume` (each
+/// drawn as a square of its domain's size scaled with its volume)
+/// coloured by `value`; returns its `summary.json` entry (`colour` names
+/// the value).
+pub(super) fn points_png<const D: usize>(
+    problem: &crate::scene::Problem<D>,
+    file: &str,
+    colour: &str,
+    (position, volume): (&[[f64; 3]], &[f64]),
+    value: &[f64],
+    dir: &std::path::Path,
+) -> Result<Value, CasesError> {
     let half: Vec<f64> = problem
         .half_lengths
         .iter()
-        .zip(&last.volume)
+        .zip(volume)
         .zip(&problem.volume)
         .map(|((l, v), v0)| l[0] * (v / v0).sqrt())
         .collect();
-    let path = dir.join("final.png");
-    let (lo, hi) = crate::scene::png::write_points_png(&path, &last.position, &half, &value)?;
-    Ok(json!({"file": "final.png", "colour": name, "blue": lo, "red": hi}))
+    let (lo, hi) = crate::scene::png::write_points_png(&dir.join(file), position, &half, value)?;
+    Ok(json!({"file": file, "colour": colour, "blue": lo, "red": hi}))
 }
 
 /// The per-point constants of the VTU files: body and material indices.

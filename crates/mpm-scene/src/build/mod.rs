@@ -27,6 +27,7 @@ mod motion;
 mod node_sets;
 mod outputs;
 mod solver;
+mod strength_reduction;
 
 use std::collections::BTreeMap;
 
@@ -48,6 +49,7 @@ use crate::format::{Axes, Field, Scene, TransferKind};
 pub use explicit_keys::{DEFAULT_CFL, DEFAULT_OUTPUTS};
 pub use loads::MANUFACTURED_FIELDS;
 pub use motion::SceneMotion;
+pub use strength_reduction::{Failure, StrengthReduction};
 
 /// Largest number of grid nodes, simplices or material points a scene may
 /// ask for (a guard against a typo allocating the machine's memory).
@@ -418,6 +420,9 @@ pub struct Problem<const D: usize> {
     /// each prefixed by where it comes from. `mpm run` prints them and
     /// writes them into `summary.json`.
     pub warnings: Vec<String>,
+    /// `[strength_reduction]`: run in trials of reduced strength for a
+    /// factor of safety; `None` for one run.
+    pub strength_reduction: Option<StrengthReduction>,
 }
 
 /// A reaction history of `[[output.reaction]]`: the sum of the reactions
@@ -647,6 +652,8 @@ impl<const D: usize> Problem<D> {
             &|name| sets.set_of(name, src),
             &|x| bodies.points.nearest(x),
         )?;
+        let strength_reduction =
+            strength_reduction::strength_reduction(scene, &probes, explicit, src)?;
         let explicit =
             explicit_run::explicit_run(explicit_keys, scene, &mesh, &materials, &bodies, src)?
                 .map(|run| run.setup(&conditions.velocity_dofs, loads.explicit));
@@ -681,6 +688,7 @@ impl<const D: usize> Problem<D> {
             fields,
             png: scene.output.png,
             explicit,
+            strength_reduction,
         })
     }
 
