@@ -10,8 +10,8 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use mpm_constitutive::{
     ConsistentTangent, DruckerPrager, HenckyElastic, LogStrainLaw, Matching, MaterialState,
-    MohrCoulomb, PreviouslyConvergedTangent, Regime, SpatialTangent, SymSpectral, VonMises,
-    VonMisesHistory, update,
+    ModifiedCamClay, ModifiedCamClayHistory, MohrCoulomb, PreviouslyConvergedTangent, Regime,
+    SpatialTangent, SymSpectral, VonMises, VonMisesHistory, update,
 };
 use nalgebra::{Matrix3, Rotation3};
 
@@ -133,7 +133,9 @@ fn constitutive(c: &mut Criterion) {
 /// \exp 2\varepsilon$ with $\varepsilon$ the elastic strain of principal
 /// stresses `sigma` (kPa, E = 10 MPa, ν = 0.3) and a rotation as $\Delta
 /// F$, so the trial stress is `sigma` in a rotated frame (c = 10 kPa,
-/// φ = 30°, ψ = 10°, hardening).
+/// φ = 30°, ψ = 10°, hardening). Modified Cam-Clay (λ̂ = 0.2, κ̂ = 0.05,
+/// M = 1.2, G = 1 MPa, p_r = 1 kPa) from its own elastic strain of
+/// `sigma`, on the wet and the dry side.
 fn soil(c: &mut Criterion) {
     let (e, nu) = (1e7, 0.3);
     let strain = |t: [f64; 3]| {
@@ -175,6 +177,22 @@ fn soil(c: &mut Criterion) {
             );
             bench_law_at(c, &format!("drucker_prager_{name}"), &dp, state, r, f_n);
         }
+    }
+    let mcc = ModifiedCamClay::new(0.2, 0.05, 1.2, 1e6, 1e3).unwrap();
+    let mcc_cases = [
+        ("wet", [-120.0, -150.0, -250.0], 150.0),
+        ("dry", [0.0, -20.0, -250.0], 300.0),
+    ];
+    for (name, sigma, pc) in mcc_cases {
+        let tau = nalgebra::Vector3::from(sigma.map(|s| s * 1e3));
+        let eps = mcc.elastic_strain_of(&tau).unwrap();
+        let state = MaterialState {
+            be: Matrix3::from_diagonal(&eps.map(|e| (2.0 * e).exp())),
+            history: ModifiedCamClayHistory::new(pc * 1e3),
+        };
+        let check = update(&mcc, &r, &f_n, &state).unwrap();
+        assert!(check.yielded(), "modified_cam_clay {name}");
+        bench_law_at(c, &format!("modified_cam_clay_{name}"), &mcc, state, r, f_n);
     }
 }
 

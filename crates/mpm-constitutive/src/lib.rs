@@ -14,7 +14,8 @@
 //! - [`kinematics`]: $b^{e,tr}$, $B$ (eq. A.2), $\tilde B$ (eq. A.5).
 //! - [`law`]: the plug-point trait [`LogStrainLaw`] for small-strain
 //!   algorithmic laws; [`HenckyElastic`], [`NeoHookean`] and [`VonMises`]
-//!   implement it.
+//!   implement it, and so do the soil laws [`MohrCoulomb`],
+//!   [`DruckerPrager`] and [`ModifiedCamClay`].
 //! - [`driver`]: the finite-strain update [`update`] generic over the law,
 //!   and the tangents [`SpatialTangent`] ($a_{ijkl}$, eq. A.1) and
 //!   [`PreviouslyConvergedTangent`] ($\tilde A_{ijkl}$, eqs. A.3–A.6).
@@ -47,6 +48,7 @@ pub mod incremental;
 pub mod kinematics;
 pub mod law;
 pub mod material_set;
+pub mod modified_cam_clay;
 pub mod mohr_coulomb;
 pub mod neo_hookean;
 pub mod point_driver;
@@ -66,6 +68,7 @@ pub use hencky::HenckyElastic;
 pub use incremental::{IncrementalLaw, Spectral};
 pub use law::{IsotropicElasticity, LawState, LogStrainLaw};
 pub use material_set::{MaterialSet, Tagged};
+pub use modified_cam_clay::{CamClayRegime, ModifiedCamClay, ModifiedCamClayHistory};
 pub use mohr_coulomb::{MohrCoulomb, MohrCoulombHistory};
 pub use neo_hookean::NeoHookean;
 pub use principal::Regime;

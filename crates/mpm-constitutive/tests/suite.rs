@@ -7,5 +7,6 @@
 mod behaviour;
 mod drucker_prager;
 mod incremental;
+mod modified_cam_clay;
 mod mohr_coulomb;
 mod tangents;
