@@ -228,7 +228,8 @@ where
                 laws.laws().len()
             ))
         })?;
-        *h = Tagged::new(m, law.initial_history());
+        let history = p.initial_history.get(k).copied();
+        *h = Tagged::new(m, history.unwrap_or_else(|| law.initial_history()));
     }
     if !p.initial_be.is_empty() {
         points.be.clone_from(&p.initial_be);

@@ -265,10 +265,12 @@ pub struct MaterialSpec {
     pub name: Spanned<String>,
     /// Constitutive model.
     pub model: MaterialModel,
-    /// Young's modulus E (Pa).
-    pub youngs_modulus: f64,
-    /// Poisson's ratio ν.
-    pub poisson_ratio: f64,
+    /// Young's modulus E (Pa); every model but `modified_cam_clay`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub youngs_modulus: Option<Spanned<f64>>,
+    /// Poisson's ratio ν; every model but `modified_cam_clay`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub poisson_ratio: Option<Spanned<f64>>,
     /// Density ϱ₀ (kg/m³).
     pub density: Spanned<f64>,
     /// Yield stress ρ_y (Pa), for `von_mises`.
@@ -291,6 +293,31 @@ pub struct MaterialSpec {
     /// `plane_strain`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub matching: Option<Spanned<ConeMatching>>,
+    /// `modified_cam_clay`: the slope λ̂ of the normal compression line in
+    /// ln p against the volumetric log strain (> κ̂).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compression_index: Option<Spanned<f64>>,
+    /// `modified_cam_clay`: the slope κ̂ of the swelling line (> 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub swelling_index: Option<Spanned<f64>>,
+    /// `modified_cam_clay`: the critical-state slope M = q/p (> 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub critical_state_slope: Option<Spanned<f64>>,
+    /// `modified_cam_clay`: the shear modulus G (Pa, > 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear_modulus: Option<Spanned<f64>>,
+    /// `modified_cam_clay`: the pressure p_r at zero elastic volumetric
+    /// strain (Pa, > 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_pressure: Option<Spanned<f64>>,
+    /// `modified_cam_clay`: the floor of the preconsolidation pressure
+    /// (Pa, ≥ 0; default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub minimum_pressure: Option<Spanned<f64>>,
+    /// `modified_cam_clay`: the over-consolidation ratio of the initial
+    /// state (≥ 1; default 1: normally consolidated).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overconsolidation_ratio: Option<Spanned<f64>>,
 }
 
 /// A region of space: a box, a polygon (2D), a sphere or disc, or a union

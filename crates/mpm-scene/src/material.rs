@@ -15,8 +15,8 @@
 
 use mpm_constitutive::{
     DruckerPrager, DruckerPragerHistory, HenckyElastic, IsotropicElasticity, LawState,
-    LogStrainLaw, Matching, MaterialSet, MohrCoulomb, MohrCoulombHistory, NeoHookean, SymSpectral,
-    Tagged, Tensor4, VonMises, VonMisesHistory,
+    LogStrainLaw, Matching, MaterialSet, ModifiedCamClay, ModifiedCamClayHistory, MohrCoulomb,
+    MohrCoulombHistory, NeoHookean, SymSpectral, Tagged, Tensor4, VonMises, VonMisesHistory,
 };
 use mpm_solver::{Flat, SolverError};
 use nalgebra::Vector3;
@@ -41,6 +41,28 @@ pub struct MaterialParams {
     pub dilation_angle: f64,
     /// How the Drucker–Prager cone matches Mohr–Coulomb.
     pub matching: Option<ConeMatching>,
+    /// Modified Cam-Clay's constants.
+    pub cam_clay: Option<CamClayParams>,
+}
+
+/// The constants of `modified_cam_clay` (SI units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CamClayParams {
+    /// λ̂: the slope of the normal compression line (ln p against the
+    /// volumetric log strain).
+    pub compression_index: f64,
+    /// κ̂: the slope of the swelling line.
+    pub swelling_index: f64,
+    /// M: the critical-state slope q/p.
+    pub critical_state_slope: f64,
+    /// G (Pa).
+    pub shear_modulus: f64,
+    /// p_r (Pa): the pressure at zero elastic volumetric strain.
+    pub reference_pressure: f64,
+    /// The floor of the preconsolidation pressure (Pa).
+    pub minimum_pressure: f64,
+    /// The over-consolidation ratio of the initial state.
+    pub overconsolidation_ratio: f64,
 }
 
 crate::variant::named_enum!(
@@ -77,6 +99,7 @@ impl MaterialParams {
             friction_angle: None,
             dilation_angle: 0.0,
             matching: None,
+            cam_clay: None,
         }
     }
 
@@ -379,6 +402,23 @@ fn matching(p: &MaterialParams) -> Result<Matching, SolverError> {
     })
 }
 
+/// Modified Cam-Clay from its constants, or an error naming them.
+fn cam_clay(p: &MaterialParams) -> Result<ModifiedCamClay, SolverError> {
+    let c = p.cam_clay.ok_or_else(|| {
+        SolverError::InvalidInput(
+            "material = modified_cam_clay needs compression_index, swelling_index, critical_state_slope, shear_modulus and reference_pressure".into(),
+        )
+    })?;
+    Ok(ModifiedCamClay::new(
+        c.compression_index,
+        c.swelling_index,
+        c.critical_state_slope,
+        c.shear_modulus,
+        c.reference_pressure,
+    )?
+    .with_minimum_pressure(c.minimum_pressure)?)
+}
+
 /// The yield stress of a plastic model, or an error naming the model.
 fn yield_stress(p: &MaterialParams, model: &str) -> Result<f64, SolverError> {
     p.yield_stress
@@ -412,6 +452,9 @@ register_laws! {
         p.hardening,
         matching(p)?,
     );
+    /// Modified Cam-Clay at finite strain (Borja & Tamagnini 1998, with a
+    /// constant shear modulus).
+    ModifiedCamClay => "modified_cam_clay", ModifiedCamClay, |p| cam_clay(p);
 }
 
 /// Output quantities of a law's history.
@@ -452,6 +495,15 @@ impl HistoryOutput for DruckerPragerHistory {
     }
 }
 
+/// Cam-Clay's history holds its preconsolidation pressure, not an
+/// accumulated plastic strain: the field reads 0 (its stresses and
+/// `p_c` tell its state).
+impl HistoryOutput for ModifiedCamClayHistory {
+    fn equivalent_plastic_strain(&self) -> f64 {
+        0.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -479,6 +531,7 @@ mod tests {
                         MaterialModel::MohrCoulomb | MaterialModel::DruckerPrager => {
                             "needs cohesion"
                         }
+                        MaterialModel::ModifiedCamClay => "needs compression_index",
                         _ => panic!("{model}: {e}"),
                     };
                     assert!(e.to_string().contains(needs), "{e}");
@@ -493,6 +546,25 @@ mod tests {
         assert!(e.to_string().contains("needs matching"), "{e}");
         p.matching = Some(ConeMatching::PlaneStrain);
         assert!(SceneLaw::new(MaterialModel::DruckerPrager, &p).is_ok());
+        let clay = CamClayParams {
+            compression_index: 0.2,
+            swelling_index: 0.05,
+            critical_state_slope: 1.2,
+            shear_modulus: 1e6,
+            reference_pressure: 1e5,
+            minimum_pressure: 0.0,
+            overconsolidation_ratio: 1.0,
+        };
+        p.cam_clay = Some(clay);
+        assert!(SceneLaw::new(MaterialModel::ModifiedCamClay, &p).is_ok());
+        p.cam_clay = Some(CamClayParams {
+            compression_index: 0.04,
+            ..clay
+        });
+        assert!(matches!(
+            SceneLaw::new(MaterialModel::ModifiedCamClay, &p),
+            Err(SolverError::Material(_))
+        ));
         p.dilation_angle = 40.0;
         assert!(matches!(
             SceneLaw::new(MaterialModel::MohrCoulomb, &p),

@@ -244,8 +244,8 @@ impl MaterialSpec {
         Self {
             name: text(name),
             model,
-            youngs_modulus,
-            poisson_ratio,
+            youngs_modulus: Some(value(youngs_modulus)),
+            poisson_ratio: Some(value(poisson_ratio)),
             density: value(density),
             yield_stress: None,
             // `#[serde(default)]`: the type's default.
@@ -254,6 +254,13 @@ impl MaterialSpec {
             friction_angle: None,
             dilation_angle: None,
             matching: None,
+            compression_index: None,
+            swelling_index: None,
+            critical_state_slope: None,
+            shear_modulus: None,
+            reference_pressure: None,
+            minimum_pressure: None,
+            overconsolidation_ratio: None,
         }
     }
 

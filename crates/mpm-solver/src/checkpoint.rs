@@ -10,7 +10,8 @@
 
 use mpm_basis::Corners;
 use mpm_constitutive::{
-    DruckerPragerHistory, MaterialState, MohrCoulombHistory, Regime, Tagged, VonMisesHistory,
+    CamClayRegime, DruckerPragerHistory, MaterialState, ModifiedCamClayHistory, MohrCoulombHistory,
+    Regime, Tagged, VonMisesHistory,
 };
 use nalgebra::{Matrix3, SVector};
 
@@ -95,6 +96,26 @@ macro_rules! flat_soil_history {
 }
 
 flat_soil_history!(MohrCoulombHistory, DruckerPragerHistory);
+
+/// Cam-Clay's preconsolidation pressure, the step's multiplier (its
+/// tangent needs it) and the regime's code.
+impl Flat for ModifiedCamClayHistory {
+    const LEN: usize = 3;
+    fn write(&self, out: &mut Vec<f64>) {
+        out.extend([
+            self.preconsolidation,
+            self.multiplier,
+            f64::from(self.regime as u8),
+        ]);
+    }
+    fn read(from: &[f64]) -> Self {
+        Self {
+            preconsolidation: from[0],
+            multiplier: from[1],
+            regime: CamClayRegime::from_code(from[2] as u8),
+        }
+    }
+}
 
 impl<const D: usize> Flat for Corners<D> {
     const LEN: usize = D << D;

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use super::{BuiltMaterial, unique_names};
 use crate::SceneError;
 use crate::format::MaterialSpec;
-use crate::material::{MaterialModel, MaterialParams, SceneLaw};
+use crate::material::{CamClayParams, MaterialModel, MaterialParams, SceneLaw};
 use crate::source::SceneSource;
 use toml::Spanned;
 
@@ -38,16 +38,28 @@ pub(super) fn materials(
                 "the explicit solver needs a positive density (the points' masses set the wave speed and the time step)",
             ));
         }
+        if explicit && spec.model == MaterialModel::ModifiedCamClay {
+            return Err(src.at(
+                &spec.name,
+                format!(
+                    "material `{}`: modified_cam_clay runs in the implicit solver (the explicit solver's time step needs the wave speed of its pressure-dependent bulk modulus per point, not built yet)",
+                    spec.name.get_ref()
+                ),
+            ));
+        }
         check_soil_keys(spec, src)?;
+        let cam_clay = super::cam_clay::params(spec, src)?;
+        let (youngs_modulus, poisson_ratio) = elastic_constants(spec, cam_clay.as_ref(), src)?;
         let mut params = MaterialParams {
-            youngs_modulus: spec.youngs_modulus,
-            poisson_ratio: spec.poisson_ratio,
+            youngs_modulus,
+            poisson_ratio,
             yield_stress: spec.yield_stress,
             hardening: spec.hardening,
             cohesion: spec.cohesion.as_ref().map(|v| *v.get_ref()),
             friction_angle: spec.friction_angle.as_ref().map(|v| *v.get_ref()),
             dilation_angle: spec.dilation_angle.as_ref().map_or(0.0, |v| *v.get_ref()),
             matching: spec.matching.as_ref().map(|v| *v.get_ref()),
+            cam_clay,
         };
         if spec.model != MaterialModel::VonMises && spec.yield_stress.is_some() {
             return Err(src.at(
@@ -83,7 +95,7 @@ pub(super) fn materials(
             return Err(src.at(
                 &spec.name,
                 format!(
-                    "material `{}` is {} but `{}` is {}: the materials of one scene share one model (hencky mixes with von_mises; mohr_coulomb and drucker_prager with each other and with hencky and neo_hookean)",
+                    "material `{}` is {} but `{}` is {}: the materials of one scene share one model (hencky mixes with von_mises; mohr_coulomb, drucker_prager and modified_cam_clay with each other and with hencky and neo_hookean)",
                     spec.name.get_ref(),
                     spec.model,
                     first.name,
@@ -99,6 +111,48 @@ pub(super) fn materials(
         });
     }
     Ok((material_names, materials))
+}
+
+/// Young's modulus and Poisson's ratio: given for every model but
+/// `modified_cam_clay`, whose elasticity is its shear modulus and its
+/// pressure-dependent bulk modulus; for it, the pair with its shear
+/// modulus and its bulk modulus at the reference pressure, p_r/κ̂ (what a
+/// stiffness-scaled stabilisation reads).
+fn elastic_constants(
+    spec: &MaterialSpec,
+    cam_clay: Option<&CamClayParams>,
+    src: &SceneSource,
+) -> Result<(f64, f64), SceneError> {
+    let name = spec.name.get_ref();
+    let keys = [
+        ("youngs_modulus", spec.youngs_modulus.as_ref()),
+        ("poisson_ratio", spec.poisson_ratio.as_ref()),
+    ];
+    if let Some(c) = cam_clay {
+        if let Some((key, Some(v))) = keys.iter().find(|(_, v)| v.is_some()) {
+            return Err(src.at(
+                v,
+                format!("material `{name}`: {key} does not apply to model = modified_cam_clay (its elasticity is shear_modulus and the bulk modulus p/κ̂)"),
+            ));
+        }
+        let (k, g) = (c.reference_pressure / c.swelling_index, c.shear_modulus);
+        return Ok((
+            9.0 * k * g / (3.0 * k + g),
+            (3.0 * k - 2.0 * g) / (2.0 * (3.0 * k + g)),
+        ));
+    }
+    let mut values = [0.0; 2];
+    for (value, (key, given)) in values.iter_mut().zip(keys) {
+        *value = *given
+            .ok_or_else(|| {
+                src.at(
+                    &spec.name,
+                    format!("material `{name}` ({}) needs {key}", spec.model),
+                )
+            })?
+            .get_ref();
+    }
+    Ok((values[0], values[1]))
 }
 
 /// The soil laws' keys: present where the model needs them, absent
@@ -186,8 +240,8 @@ fn check_ranges(spec: &MaterialSpec, src: &SceneSource) -> Result<(), SceneError
 /// law or an elastic one (a footing on soil): the run-time law set holds
 /// both, each point with its own.
 fn mixes_with_soil(a: MaterialModel, b: MaterialModel) -> bool {
-    use MaterialModel::{DruckerPrager, Hencky, MohrCoulomb, NeoHookean};
-    let soil = |m| matches!(m, MohrCoulomb | DruckerPrager);
+    use MaterialModel::{DruckerPrager, Hencky, ModifiedCamClay, MohrCoulomb, NeoHookean};
+    let soil = |m| matches!(m, MohrCoulomb | DruckerPrager | ModifiedCamClay);
     let elastic = |m| matches!(m, Hencky | NeoHookean);
     (soil(a) && (soil(b) || elastic(b))) || (soil(b) && elastic(a))
 }

@@ -15,6 +15,7 @@
 //! This file keeps the types they build and the checks they share.
 
 mod bodies;
+mod cam_clay;
 mod conditions;
 mod curves;
 mod explicit_keys;
@@ -380,6 +381,10 @@ pub struct Problem<const D: usize> {
     /// The elastic left Cauchy–Green tensor every point starts from, from
     /// its body's `initial_stress` (empty: every point stress-free).
     pub initial_be: Vec<nalgebra::Matrix3<f64>>,
+    /// The history every point starts from (empty: its law's default):
+    /// the state of `initial_stress` (Cam-Clay's preconsolidation
+    /// pressure).
+    pub initial_history: Vec<crate::material::SceneHistory>,
     /// Proportional body force per point (empty if none).
     pub body_force: Vec<SVector<f64, D>>,
     /// Proportional point forces.
@@ -630,7 +635,8 @@ impl<const D: usize> Problem<D> {
             explicit,
             src,
         )?;
-        let initial_be = initial_stress::initial_be(&scene.bodies, &bodies, &materials, src)?;
+        let (initial_be, initial_history) =
+            initial_stress::initial_state_of_points(&scene.bodies, &bodies, &materials, src)?;
         let sets = node_sets::node_sets(&scene.node_sets, &mesh, &bodies, src)?;
         let conditions = conditions::conditions(scene, &mesh, &sets, &curves, explicit, src)?;
         let loads = loads::loads(
@@ -673,6 +679,7 @@ impl<const D: usize> Problem<D> {
             body_of_point: points.body,
             constraints: conditions.constraints,
             initial_be,
+            initial_history,
             body_force: loads.body_force,
             point_forces: loads.point_forces,
             curved: loads.curved,

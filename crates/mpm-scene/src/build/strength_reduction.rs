@@ -80,6 +80,19 @@ pub(super) fn strength_reduction(
             "strength_reduction runs the implicit solver (quasi-static trials); remove it or `kind = \"explicit\"`",
         ));
     }
+    if let Some(m) = scene
+        .materials
+        .iter()
+        .find(|m| m.model == crate::material::MaterialModel::ModifiedCamClay)
+    {
+        return Err(src.at(
+            &m.name,
+            format!(
+                "strength_reduction divides c, tan φ and the yield stress; material `{}` is modified_cam_clay, whose strength it does not reduce",
+                m.name.get_ref()
+            ),
+        ));
+    }
     let t: &StrengthReductionSpec = table.get_ref();
     let lower = positive(&t.lower, 1.0, "lower", src)?;
     let upper = positive(&t.upper, 2.0 * lower, "upper", src)?;
