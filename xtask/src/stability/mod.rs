@@ -494,7 +494,7 @@ const FAMILIES: [(&str, &str); 9] = [
     ),
     (
         "soil",
-        "The soil laws (issue 43): the Mohr–Coulomb strip footing of `scenes/footing_mohr_coulomb.toml` (error: q/c against Prandtl–Reissner's N_c, 14.835 at φ = 20°, 2 + π at φ = 0, on a coarse grid) with φ → 0, associated against non-associated flow and 10× steps; a laterally confined block pulled apart to the apex in tension (error: the top traction against c cot φ).",
+        "The soil laws (issue 43): the Mohr–Coulomb strip footing of `scenes/footing_mohr_coulomb.toml` (error: q/c against Prandtl–Reissner's N_c, 14.835 at φ = 20°, 2 + π at φ = 0, on a coarse grid) with φ → 0, associated against non-associated flow and 10× steps; a laterally confined block pulled apart to the apex in tension (error: the top traction against c cot φ); modified Cam-Clay's undrained triaxial cell (`scenes/triaxial_cam_clay.toml`) normally and very heavily (OCR = 1000) over-consolidated and in 10× steps, and a geostatic Cam-Clay column under a surface load of twice its base pressure in 5 steps and in 1.",
     ),
     (
         "failure",
