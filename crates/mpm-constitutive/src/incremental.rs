@@ -94,7 +94,7 @@ impl<L: IncrementalLaw> IncrementalLaw for MaterialSet<L> {
 
     #[inline(always)]
     fn point_p_wave_modulus(&self, state: &Self::State) -> f64 {
-        self.law(state.material).p_wave_modulus()
+        self.law(state.material).point_p_wave_modulus(&state.inner)
     }
 }
 
@@ -165,6 +165,15 @@ impl<L: LogStrainLaw> IncrementalLaw for Spectral<L> {
 
     fn p_wave_modulus(&self) -> f64 {
         self.p_wave_modulus
+    }
+
+    /// The law's modulus at the point's state when it depends on it
+    /// ([`LogStrainLaw::state_p_wave_modulus`]), the constant otherwise.
+    #[inline(always)]
+    fn point_p_wave_modulus(&self, state: &Self::State) -> f64 {
+        self.law
+            .state_p_wave_modulus(&state.be, &state.history)
+            .unwrap_or(self.p_wave_modulus)
     }
 }
 

@@ -118,6 +118,17 @@ pub trait LogStrainLaw: Send + Sync {
         self.elasticity().map(|e| e.mu)
     }
 
+    /// The P-wave modulus $K + \tfrac43G$ of a point whose elastic left
+    /// Cauchy–Green tensor is `be`, when the law's stiffness depends on
+    /// its state (Cam-Clay's bulk modulus $p/\hat\kappa$): the explicit
+    /// solver's time step takes each point's wave speed from it. `None`
+    /// (the default): the constant modulus of [`Self::elasticity`].
+    #[inline]
+    fn state_p_wave_modulus(&self, be: &Matrix3<f64>, history: &Self::History) -> Option<f64> {
+        let _ = (be, history);
+        None
+    }
+
     /// The stored (recoverable) energy per unit reference volume of the
     /// elastic Hencky strain with principal values `elastic_strain`, for
     /// energy balances; plastic dissipation is not included. `None` when

@@ -102,6 +102,16 @@ impl<L: LogStrainLaw> LogStrainLaw for MaterialSet<L> {
         self.law(state.history.material).regime(&untagged(state))
     }
 
+    #[inline]
+    fn state_p_wave_modulus(
+        &self,
+        be: &nalgebra::Matrix3<f64>,
+        history: &Self::History,
+    ) -> Option<f64> {
+        self.law(history.material)
+            .state_p_wave_modulus(be, &history.inner)
+    }
+
     #[inline(always)]
     fn return_map(&self, trial: &SymSpectral, history: &Self::History) -> LawState<Self::History> {
         let state = self.law(history.material).return_map(trial, &history.inner);

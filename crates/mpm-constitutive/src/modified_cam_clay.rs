@@ -664,6 +664,18 @@ impl LogStrainLaw for ModifiedCamClay {
     /// The hardening makes the tangent unsymmetric (module docs).
     const SYMMETRIC_TANGENT: bool = false;
 
+    /// $p/\hat\kappa + \tfrac43G$ at the elastic volumetric strain
+    /// $\varepsilon_v = \tfrac12\ln\det b^e$ (no eigen-decomposition).
+    #[inline]
+    fn state_p_wave_modulus(
+        &self,
+        be: &nalgebra::Matrix3<f64>,
+        _history: &ModifiedCamClayHistory,
+    ) -> Option<f64> {
+        let ev = 0.5 * be.determinant().ln();
+        Some(self.bulk_modulus_at(self.pressure(ev)) + 4.0 / 3.0 * self.shear)
+    }
+
     fn return_map(
         &self,
         trial: &SymSpectral,

@@ -237,3 +237,35 @@ fn a_material_set_answers_as_each_points_law() {
     assert!(set.update(&flip, &mut tagged).is_err());
     assert_eq!(tagged, before);
 }
+
+/// Cam-Clay's stiffness grows with the pressure, so the explicit step
+/// takes each point's wave speed at its own state (issue 43): the P-wave
+/// modulus of a point is p/κ̂ + 4G/3 at its elastic volumetric strain (to
+/// rounding), not the modulus given for the law, and a material set
+/// answers with each point's own.
+#[test]
+fn cam_clay_points_have_the_wave_modulus_of_their_pressure() {
+    use mpm_constitutive::{ModifiedCamClay, ModifiedCamClayHistory};
+    let (kappa, g) = (0.05, 5.0e6);
+    let clay = ModifiedCamClay::new(0.2, kappa, 1.2, g, 1.0e5).unwrap();
+    let law = Spectral::with_p_wave_modulus(clay, clay.p_wave_modulus_at(1.0e5).unwrap()).unwrap();
+    let set = MaterialSet::new(vec![law, law]).unwrap();
+    let mut moduli = Vec::new();
+    for p in [2.0e4, 1.0e5, 8.0e5] {
+        let tau = nalgebra::Vector3::new(-p - 1.0e4, -p + 5.0e3, -p + 5.0e3);
+        let eps = clay.elastic_strain_of(&tau).unwrap();
+        let state = MaterialState {
+            be: Matrix3::from_diagonal(&eps.map(|e| (2.0 * e).exp())),
+            history: ModifiedCamClayHistory::new(2.0 * p),
+        };
+        let expected = p / kappa + 4.0 / 3.0 * g;
+        let got = law.point_p_wave_modulus(&state);
+        assert!(
+            (got - expected).abs() <= 1e-12 * expected,
+            "p = {p}: {got} against {expected}"
+        );
+        assert_eq!(set.point_p_wave_modulus(&Tagged::new(1, state)), got);
+        moduli.push(got);
+    }
+    assert!(moduli[0] < law.p_wave_modulus() && law.p_wave_modulus() < moduli[2]);
+}

@@ -676,6 +676,12 @@ where
             SolverError::InvalidInput("this law's state cannot start from an initial stress".into())
         })? = *be;
     }
+    let mut flat = Vec::new();
+    for (state, history) in points.material.iter_mut().zip(&problem.initial_history) {
+        flat.clear();
+        history.write(&mut flat);
+        state.set_history(&flat);
+    }
     if points.mass.len() != points.len() || points.velocity.len() != points.len() {
         return Err(SolverError::InvalidInput(format!(
             "{} points but {} masses and {} velocities",
@@ -1108,6 +1114,12 @@ pub trait FlatState: Copy + Default + Send + Sync + std::fmt::Debug + PartialEq 
     fn elastic_left_cauchy_green(&mut self) -> Option<&mut Matrix3<f64>> {
         None
     }
+    /// Sets the history of a law's state from the flat form of the scene's
+    /// initial history (`Problem::initial_history`, a `SceneHistory`: the
+    /// scene's laws' states hold one); nothing for a state without one.
+    fn set_history(&mut self, flat: &[f64]) {
+        let _ = flat;
+    }
 }
 
 /// A [`MaterialSet`]'s state: the material index, then the law's state.
@@ -1140,6 +1152,9 @@ impl<S: FlatState> FlatState for Tagged<S> {
     fn elastic_left_cauchy_green(&mut self) -> Option<&mut Matrix3<f64>> {
         self.inner.elastic_left_cauchy_green()
     }
+    fn set_history(&mut self, flat: &[f64]) {
+        self.inner.set_history(flat);
+    }
 }
 
 impl<H> FlatState for MaterialState<H>
@@ -1162,6 +1177,11 @@ where
     }
     fn elastic_left_cauchy_green(&mut self) -> Option<&mut Matrix3<f64>> {
         Some(&mut self.be)
+    }
+    fn set_history(&mut self, flat: &[f64]) {
+        if flat.len() == H::LEN {
+            self.history = H::read(flat);
+        }
     }
 }
 

@@ -44,6 +44,18 @@ impl ExplicitLaw {
                 params.youngs_modulus,
                 params.poisson_ratio,
             )?),
+            MaterialModel::ModifiedCamClay => {
+                let law = SceneLaw::new(model, params)?;
+                // The modulus at the reference pressure stands for the
+                // law (a set's bound); each point's step takes its own
+                // state's (`point_p_wave_modulus`).
+                let reference = params.cam_clay.map_or(0.0, |c| c.reference_pressure);
+                let m = match &law {
+                    SceneLaw::ModifiedCamClay(clay) => clay.p_wave_modulus_at(reference)?,
+                    _ => 0.0,
+                };
+                Self::Spectral(Spectral::with_p_wave_modulus(law, m)?)
+            }
             _ => Self::Spectral(Spectral::new(SceneLaw::new(model, params)?)?),
         })
     }
@@ -90,6 +102,14 @@ impl IncrementalLaw for ExplicitLaw {
         match self {
             Self::ClosedForm(law) => IncrementalLaw::p_wave_modulus(law),
             Self::Spectral(law) => law.p_wave_modulus(),
+        }
+    }
+
+    #[inline(always)]
+    fn point_p_wave_modulus(&self, state: &Self::State) -> f64 {
+        match self {
+            Self::ClosedForm(law) => IncrementalLaw::p_wave_modulus(law),
+            Self::Spectral(law) => law.point_p_wave_modulus(state),
         }
     }
 }

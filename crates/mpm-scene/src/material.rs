@@ -327,6 +327,16 @@ macro_rules! register_laws {
                 }
             }
 
+            #[inline]
+            fn state_p_wave_modulus(&self, be: &nalgebra::Matrix3<f64>, history: &SceneHistory) -> Option<f64> {
+                match self {
+                    $(SceneLaw::$variant(law) => {
+                        let h = own_history!($variant, history);
+                        law.state_p_wave_modulus(be, &h)
+                    })+
+                }
+            }
+
             fn stored_energy(&self, elastic_strain: &Vector3<f64>, history: &SceneHistory) -> Option<f64> {
                 match self {
                     $(SceneLaw::$variant(law) => {

@@ -38,15 +38,6 @@ pub(super) fn materials(
                 "the explicit solver needs a positive density (the points' masses set the wave speed and the time step)",
             ));
         }
-        if explicit && spec.model == MaterialModel::ModifiedCamClay {
-            return Err(src.at(
-                &spec.name,
-                format!(
-                    "material `{}`: modified_cam_clay runs in the implicit solver (the explicit solver's time step needs the wave speed of its pressure-dependent bulk modulus per point, not built yet)",
-                    spec.name.get_ref()
-                ),
-            ));
-        }
         check_soil_keys(spec, src)?;
         let cam_clay = super::cam_clay::params(spec, src)?;
         let (youngs_modulus, poisson_ratio) = elastic_constants(spec, cam_clay.as_ref(), src)?;
