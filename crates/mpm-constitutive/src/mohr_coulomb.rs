@@ -31,6 +31,80 @@
 //!
 //! The algorithmic tangent of each regime is the derivative of its closed
 //! form, made a tensor by [`crate::principal::tangent`].
+//!
+//! # Tension cut-off
+//! The pyramid admits tensile principal stresses up to its apex $c\cot
+//! \phi$, far more than a soil carries: in uniaxial tension it fails at
+//! $2c\cos\phi/(1 + \sin\phi)$. [`MohrCoulomb::with_tension_cutoff`]
+//! adds the Rankine criterion $\tau_a \le \sigma_t$ on every principal
+//! stress, perfectly plastic with associated flow, $\sigma_t\le c_0\cot
+//! \phi$ so that it cuts the apex (de Souza Neto, Perić & Owen 2008,
+//! ch. 8: the multi-surface return by active sets; §8.2 for the pyramid).
+//! In sorted order the surfaces are the planes
+//! $$ P_1 = f_1,\quad P_2: (\tau_2, \tau_3),\quad P_3: (\tau_1,
+//!   \tau_2),\qquad T_a = \tau_a - \sigma_t, $$
+//! $P_2$ and $P_3$ the planes of the compression and extension edges, the
+//! flow of $T_a$ the unit vector $\mathbf e_a$. Elasticity is linear and
+//! only the Mohr–Coulomb planes harden, so every active set $\mathcal A$
+//! is the linear system $A\Delta\boldsymbol\gamma = \mathbf f^{tr}$,
+//! $A_{ij} = \mathbf a_i\cdot D\mathbf n_j + h_{ij}$ with $h_{ij} = h$
+//! when both planes are Mohr–Coulomb planes and 0 otherwise, the elastic
+//! strain $\varepsilon^{tr} - \sum_j\Delta\gamma_j\mathbf n_j$ and
+//! $\Delta\alpha = 2\cos\phi$ times the sum of the Mohr–Coulomb
+//! multipliers.
+//!
+//! The pyramid's return is kept whenever it ends with $\tau_1\le
+//! \sigma_t$ (then it satisfies every condition of the combined problem;
+//! without a cut-off nothing changes). Otherwise the faces, edges and
+//! vertices of the cut pyramid in the sorted sector are tried in turn, the
+//! first valid one taken:
+//!
+//! | regime | active set | stresses |
+//! | --- | --- | --- |
+//! | [`Regime::Tension`] | $T_1$ | $\tau_1 = \sigma_t$ |
+//! | [`Regime::TensionPlane`] | $P_1, T_1$ | $\tau_1 = \sigma_t$, $\tau_3$ on $P_1$ |
+//! | [`Regime::TensionEdge`] | $T_1, T_2$ | $\tau_1 = \tau_2 = \sigma_t$ |
+//! | [`Regime::TensionExtensionEdge`] | $P_1, P_3, T_1$ | $\tau_1 = \sigma_t$, $\tau_2 = \tau_3$ on $P_1$ |
+//! | [`Regime::TensionCompressionEdge`] | $P_1, (P_2,) T_1, T_2$ | $\tau_1 = \tau_2 = \sigma_t$, $\tau_3$ on $P_1$ |
+//! | [`Regime::TensionApex`] | $T_1, T_2, T_3$ | $\tau = \sigma_t\mathbf 1$ |
+//!
+//! Valid means: multipliers $\ge 0$, every plane satisfied with the
+//! hardened cohesion and the order $\tau_1\ge\tau_2\ge\tau_3$ kept, all
+//! to rounding. Nothing else can be active: $T_1$ alone is smooth across
+//! $\tau_2 = \tau_3$ (a return to it never breaks that order), and the
+//! pyramid's apex lies beyond the cut-off. The apex of the cut-off is
+//! always admissible and the last resort.
+//!
+//! One vertex is degenerate. Where the compression edge meets the tension
+//! edge four planes pass through one point: $P_1$ and $P_2$ coincide on
+//! $\tau_1 = \tau_2$ ($\mathbf a_{P_1} - \mathbf a_{P_2} = (1 +
+//! \sin\phi)(\mathbf e_1 - \mathbf e_2)$). The stress there is fixed by
+//! $\{P_1, T_1, T_2\}$ and its hardening, whatever the split of the
+//! Mohr–Coulomb multiplier $\Gamma$ between $P_1$ and $P_2$, so that
+//! system is solved; its multipliers $(\Gamma, g_1, g_2)$ are valid when
+//! some split leaves all four non-negative, i.e. $\Gamma\ge0$, $g_2\ge
+//! 0$, $g_1 + g_2\ge0$ and $\Gamma(1 + \sin\psi) + g_1\ge0$. Requiring
+//! $g_1\ge0$ instead (no $P_2$) rejects part of the trials of that
+//! vertex, which then fall through to the apex of the cut-off, a wrong
+//! stress (e.g. $\sigma_t\mathbf 1$ for $(\sigma_t, \sigma_t, -19.6)$ kPa
+//! at $c = 10$ kPa, $\phi = \psi = 30°$, $\sigma_t = 5$ kPa).
+//!
+//! The tangent of an active set is the derivative of its linear system,
+//! $$ \frac{\partial\tau}{\partial\varepsilon} = D - \sum_{ij}
+//!   (D\mathbf n_i)(A^{-1})_{ij}(D\mathbf a_j)^T, $$
+//! zero at the apex of the cut-off. The tension planes are associated,
+//! so with $\psi = \phi$ every $A$ and tangent is symmetric. With $\psi
+//! \ne\phi$ the tangents of the cut-off are symmetric still: $\mathbf
+//! a_{P_1} - \mathbf n_{P_1} = (\sin\phi - \sin\psi)(\mathbf e_1 +
+//! \mathbf e_3)$ lies in the span of the active gradients whenever $T_1$
+//! is active, so flows and gradients span the same space and, without
+//! hardening, the tangent is $D - DG(G^TDG)^{-1}G^TD$ ($G$ the gradients)
+//! for either; the hardening moves the stress along one direction,
+//! $A^{-T}\mathbf m$ with $\mathbf m$ marking the Mohr–Coulomb planes,
+//! the same for both ($\mathbf e_3$, or $\mathbf e_2 + \mathbf e_3$ on
+//! the extension edge). The pyramid's own regimes are not, so
+//! [`LogStrainLaw::symmetric_tangent`] ($\psi = \phi$) is unchanged by
+//! the cut-off.
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 
@@ -40,6 +114,10 @@ use crate::principal::{self, Regime};
 use crate::spectral::SymSpectral;
 use crate::tensor::Tensor4;
 use crate::von_mises::YIELD_TOLERANCE;
+
+/// Relative rounding by which a tensile strength may exceed the apex
+/// $c_0\cot\phi$ ([`MohrCoulomb::with_tension_cutoff`]).
+pub const APEX_SLACK: f64 = 1e-12;
 
 /// Internal variables of [`MohrCoulomb`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -59,13 +137,16 @@ pub struct MohrCoulomb {
     sin_phi: f64,
     cos_phi: f64,
     sin_psi: f64,
+    /// The tensile strength $\sigma_t$ of the cut-off, if any.
+    tension: Option<f64>,
 }
 
 /// What a return found, in sorted order.
 struct Return {
     regime: Regime,
     /// Plastic multipliers of the planes used (apex: the volumetric
-    /// plastic strain in `gamma[0]`).
+    /// plastic strain in `gamma[0]`; a return to the cut-off: the sum of
+    /// its Mohr–Coulomb multipliers in `gamma[0]`).
     gamma: Vector2<f64>,
     /// Returned elastic strain, sorted.
     strain: Vector3<f64>,
@@ -86,7 +167,47 @@ impl MohrCoulomb {
             sin_phi,
             cos_phi,
             sin_psi,
+            tension: None,
         })
+    }
+
+    /// The same law with the tension cut-off (Rankine) $\tau_a \le
+    /// \sigma_t$ at the tensile strength $\sigma_t$ = `tensile_strength`
+    /// (module docs, "Tension cut-off"): finite, $\ge 0$ and, for a
+    /// friction angle $\phi > 0$, at most $c_0\cot\phi$, so that the
+    /// cut-off cuts the apex of the pyramid. A value above the apex by rounding ([`APEX_SLACK`]
+    /// relative, e.g. $c_0/\tan\phi$ against $c_0\cos\phi/\sin\phi$) is
+    /// taken as the apex.
+    pub fn with_tension_cutoff(self, tensile_strength: f64) -> Result<Self> {
+        if !(tensile_strength.is_finite() && tensile_strength >= 0.0) {
+            return Err(ConstitutiveError::InvalidParameter {
+                name: "tensile strength",
+                value: tensile_strength,
+                range: "finite and >= 0",
+            });
+        }
+        let apex = self.apex_bound().unwrap_or(f64::INFINITY);
+        if tensile_strength > apex * (1.0 + APEX_SLACK) {
+            return Err(ConstitutiveError::InvalidParameter {
+                name: "tensile strength",
+                value: tensile_strength,
+                range: "<= c0 cot(friction angle), the apex of the pyramid (the cut-off must cut it)",
+            });
+        }
+        Ok(Self {
+            tension: Some(tensile_strength.min(apex)),
+            ..self
+        })
+    }
+
+    /// The tensile strength $\sigma_t$ of the cut-off, `None` without one.
+    pub fn tension_cutoff(&self) -> Option<f64> {
+        self.tension
+    }
+
+    /// $c_0\cot\phi$, the apex of the pyramid, for $\phi > 0$.
+    fn apex_bound(&self) -> Option<f64> {
+        (self.sin_phi > 0.0).then(|| self.cohesion * self.cos_phi / self.sin_phi)
     }
 
     /// The elastic constants.
@@ -100,8 +221,22 @@ impl MohrCoulomb {
     }
 
     /// The same law with $c$ and $\tan\phi$ divided by `factor` (strength
-    /// reduction), the dilation angle capped at the reduced friction angle.
+    /// reduction), the dilation angle capped at the reduced friction angle,
+    /// and the tensile strength divided by `factor` too. The reduced apex
+    /// $(c_0/F)\cot\phi_F = c_0\cot\phi$ does not move, so for $F \ge 1$
+    /// the reduced cut-off $\sigma_t/F$ still cuts it; for $F < 1$ (a
+    /// strength increase) $\sigma_t/F$ is capped at the apex.
     pub fn reduced(&self, factor: f64) -> Result<Self> {
+        let law = self.reduced_pyramid(factor)?;
+        let Some(tension) = self.tension else {
+            return Ok(law);
+        };
+        let reduced = tension / factor;
+        law.with_tension_cutoff(law.apex_bound().map_or(reduced, |apex| reduced.min(apex)))
+    }
+
+    /// [`Self::reduced`] without the cut-off.
+    fn reduced_pyramid(&self, factor: f64) -> Result<Self> {
         let tan_phi = self.sin_phi / self.cos_phi / factor;
         let phi = tan_phi.atan().to_degrees();
         let psi = self.sin_psi.asin().to_degrees().min(phi);
@@ -158,8 +293,22 @@ impl MohrCoulomb {
         YIELD_TOLERANCE * (2.0 * self.cohesion(history) * self.cos_phi).max(sigma.amax())
     }
 
-    /// The return of the sorted trial strain `eps` (module docs).
+    /// The return of the sorted trial strain `eps` (module docs): to the
+    /// pyramid, and past the cut-off when that leaves $\tau_1 > \sigma_t$.
     fn sorted_return(&self, eps: &Vector3<f64>, history: &MohrCoulombHistory) -> Return {
+        let r = self.pyramid_return(eps, history);
+        let Some(t) = self.tension else {
+            return r;
+        };
+        let tol = self.tolerance(&(self.elastic() * eps), history);
+        if (self.elastic() * r.strain).max() <= t + tol {
+            return r;
+        }
+        self.tension_return(eps, history, t, tol)
+    }
+
+    /// The return of the sorted trial strain `eps` to the pyramid alone.
+    fn pyramid_return(&self, eps: &Vector3<f64>, history: &MohrCoulombHistory) -> Return {
         let de = self.elastic();
         let sigma = de * eps;
         let k = 2.0 * self.cohesion(history) * self.cos_phi;
@@ -316,6 +465,12 @@ impl MohrCoulomb {
                 let r = self.apex_ratio();
                 Matrix3::from_element(self.elasticity.bulk * r / (1.0 + r))
             }
+            Regime::Tension
+            | Regime::TensionPlane
+            | Regime::TensionEdge
+            | Regime::TensionExtensionEdge
+            | Regime::TensionCompressionEdge
+            | Regime::TensionApex => self.active_tangent(regime),
         }
     }
 
@@ -323,6 +478,15 @@ impl MohrCoulomb {
     /// as elastic: the plane (or the edge or apex the stresses sit on) when
     /// the trial lies on the surface to rounding, elastic otherwise.
     fn loading_regime(&self, eps: &Vector3<f64>, history: &MohrCoulombHistory) -> Regime {
+        let regime = self.pyramid_loading_regime(eps, history);
+        match self.tension {
+            Some(t) => self.tension_loading_regime(eps, history, t, regime),
+            None => regime,
+        }
+    }
+
+    /// [`Self::loading_regime`] of the pyramid alone.
+    fn pyramid_loading_regime(&self, eps: &Vector3<f64>, history: &MohrCoulombHistory) -> Regime {
         let sigma = self.elastic() * eps;
         let k = 2.0 * self.cohesion(history) * self.cos_phi;
         let f1 = Self::plane(0, 2, self.sin_phi).dot(&sigma) - k;
@@ -475,5 +639,229 @@ impl MohrCoulomb {
         let order = principal::descending(&trial.values);
         let d = principal::unsort_matrix(&self.sorted_tangent(regime), order);
         principal::tangent(trial, &state.tau, &d)
+    }
+}
+
+/// A plane of the yield surface in sorted principal stresses (module docs,
+/// "Tension cut-off").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Surface {
+    /// The Mohr–Coulomb plane through the pair `(i, j)`, `i` the larger:
+    /// $P_1 = (0, 2)$, $P_2 = (1, 2)$, $P_3 = (0, 1)$.
+    Shear(usize, usize),
+    /// The tension plane $T_{a+1}$: $\tau_a = \sigma_t$.
+    Tension(usize),
+}
+
+const P1: Surface = Surface::Shear(0, 2);
+const P3: Surface = Surface::Shear(0, 1);
+const T1: Surface = Surface::Tension(0);
+const T2: Surface = Surface::Tension(1);
+const T3: Surface = Surface::Tension(2);
+
+/// The active sets tried, in order, when the pyramid's return leaves
+/// $\tau_1 > \sigma_t$; [`Regime::TensionApex`] is the last resort.
+const CANDIDATES: [Regime; 5] = [
+    Regime::Tension,
+    Regime::TensionPlane,
+    Regime::TensionEdge,
+    Regime::TensionExtensionEdge,
+    Regime::TensionCompressionEdge,
+];
+
+/// The planes solved for in a regime of the cut-off ($P_2$ of
+/// [`Regime::TensionCompressionEdge`] coincides with $P_1$ there and is
+/// left out: module docs).
+fn active_set(regime: Regime) -> &'static [Surface] {
+    match regime {
+        Regime::Tension => &[T1],
+        Regime::TensionPlane => &[P1, T1],
+        Regime::TensionEdge => &[T1, T2],
+        Regime::TensionExtensionEdge => &[P1, P3, T1],
+        Regime::TensionCompressionEdge => &[P1, T1, T2],
+        Regime::TensionApex => &[T1, T2, T3],
+        _ => &[],
+    }
+}
+
+/// The gradients and multipliers of an active set: yield gradients $\mathbf
+/// a_i$ and flow directions $\mathbf n_i$ as columns (zero past the set's
+/// size) and $A_{ij} = \mathbf a_i\cdot D\mathbf n_j + h_{ij}$ (the
+/// identity past the set's size, so that unused multipliers vanish).
+struct ActiveSystem {
+    a: Matrix3<f64>,
+    n: Matrix3<f64>,
+    matrix: Matrix3<f64>,
+}
+
+impl MohrCoulomb {
+    /// Yield gradient and flow direction of a plane.
+    fn gradients(&self, surface: Surface) -> (Vector3<f64>, Vector3<f64>) {
+        match surface {
+            Surface::Shear(i, j) => (
+                Self::plane(i, j, self.sin_phi),
+                Self::plane(i, j, self.sin_psi),
+            ),
+            Surface::Tension(a) => {
+                let e = Vector3::ith(a, 1.0);
+                (e, e)
+            }
+        }
+    }
+
+    fn active_system(&self, set: &[Surface]) -> ActiveSystem {
+        let (mut a, mut n) = (Matrix3::zeros(), Matrix3::zeros());
+        for (i, &surface) in set.iter().enumerate() {
+            let (ai, ni) = self.gradients(surface);
+            a.set_column(i, &ai);
+            n.set_column(i, &ni);
+        }
+        let mut matrix = a.transpose() * self.elastic() * n;
+        for i in 0..3 {
+            for j in 0..3 {
+                match (set.get(i), set.get(j)) {
+                    (Some(Surface::Shear(..)), Some(Surface::Shear(..))) => {
+                        matrix[(i, j)] += self.h();
+                    }
+                    (Some(_), Some(_)) => {}
+                    _ => matrix[(i, j)] = if i == j { 1.0 } else { 0.0 },
+                }
+            }
+        }
+        ActiveSystem { a, n, matrix }
+    }
+
+    /// The return of the sorted trial `eps` with the planes of `regime`
+    /// active, from the strengths $k = 2c_n\cos\phi$ and $\sigma_t$ = `t`,
+    /// and all its multipliers; `None` if $A$ is singular.
+    fn active_return(
+        &self,
+        eps: &Vector3<f64>,
+        k: f64,
+        t: f64,
+        regime: Regime,
+    ) -> Option<(Return, Vector3<f64>)> {
+        let set = active_set(regime);
+        let system = self.active_system(set);
+        let sigma = self.elastic() * eps;
+        let f = Vector3::from_fn(|i, _| match set.get(i) {
+            Some(Surface::Shear(..)) => system.a.column(i).dot(&sigma) - k,
+            Some(Surface::Tension(_)) => system.a.column(i).dot(&sigma) - t,
+            None => 0.0,
+        });
+        let gamma = system.matrix.lu().solve(&f)?;
+        let shear: f64 = set
+            .iter()
+            .zip(gamma.iter())
+            .filter(|(s, _)| matches!(s, Surface::Shear(..)))
+            .map(|(_, g)| g)
+            .sum();
+        let r = Return {
+            regime,
+            gamma: Vector2::new(shear, 0.0),
+            strain: eps - system.n * gamma,
+        };
+        Some((r, gamma))
+    }
+
+    /// Whether a return of [`Self::active_return`] solves the problem:
+    /// multipliers non-negative, every plane satisfied with the hardened
+    /// cohesion and the order kept, all to `tol` (a stress; multipliers to
+    /// `tol`$/\mu$).
+    fn admissible(
+        &self,
+        r: &Return,
+        gamma: &Vector3<f64>,
+        history: &MohrCoulombHistory,
+        t: f64,
+        tol: f64,
+    ) -> bool {
+        let tau = self.elastic() * r.strain;
+        let hardened = MohrCoulombHistory {
+            alpha: history.alpha + 2.0 * self.cos_phi * r.gamma[0],
+            regime: r.regime,
+        };
+        let ordered = tau[0] >= tau[1] - tol && tau[1] >= tau[2] - tol;
+        ordered
+            && self.flows_forward(r.regime, gamma) >= -tol / self.elasticity.mu
+            && self.yield_function(&tau, &hardened) <= tol
+            && tau.max() <= t + tol
+    }
+
+    /// The smallest multiplier of a return; on
+    /// [`Regime::TensionCompressionEdge`] the smallest of the conditions
+    /// that some split of the main-plane multiplier between $P_1$ and
+    /// $P_2$ leaves all four non-negative (module docs).
+    fn flows_forward(&self, regime: Regime, gamma: &Vector3<f64>) -> f64 {
+        if regime != Regime::TensionCompressionEdge {
+            return gamma.min();
+        }
+        let first = gamma[0] * (1.0 + self.sin_psi) + gamma[1];
+        gamma[0].min(gamma[2]).min(gamma[1] + gamma[2]).min(first)
+    }
+
+    /// The return past the cut-off: the first admissible candidate, else
+    /// the apex of the cut-off.
+    fn tension_return(
+        &self,
+        eps: &Vector3<f64>,
+        history: &MohrCoulombHistory,
+        t: f64,
+        tol: f64,
+    ) -> Return {
+        let k = 2.0 * self.cohesion(history) * self.cos_phi;
+        CANDIDATES
+            .iter()
+            .find_map(|&regime| {
+                let (r, gamma) = self.active_return(eps, k, t, regime)?;
+                self.admissible(&r, &gamma, history, t, tol).then_some(r)
+            })
+            .unwrap_or(Return {
+                regime: Regime::TensionApex,
+                gamma: Vector2::zeros(),
+                strain: Vector3::from_element(t / (3.0 * self.elasticity.bulk)),
+            })
+    }
+
+    /// $D - \sum_{ij}(D\mathbf n_i)(A^{-1})_{ij}(D\mathbf a_j)^T$ of a
+    /// regime of the cut-off (zero at its apex).
+    fn active_tangent(&self, regime: Regime) -> Matrix3<f64> {
+        let de = self.elastic();
+        if regime == Regime::TensionApex {
+            return Matrix3::zeros();
+        }
+        let system = self.active_system(active_set(regime));
+        let Some(inv) = system.matrix.try_inverse() else {
+            return de;
+        };
+        de - (de * system.n) * inv * (de * system.a).transpose()
+    }
+
+    /// [`Self::loading_regime`] with the cut-off: the regime of the planes
+    /// the stresses sit on when $\tau_1 = \sigma_t$ to rounding, `pyramid`
+    /// (the pyramid's loading regime) otherwise.
+    fn tension_loading_regime(
+        &self,
+        eps: &Vector3<f64>,
+        history: &MohrCoulombHistory,
+        t: f64,
+        pyramid: Regime,
+    ) -> Regime {
+        let sigma = self.elastic() * eps;
+        let k = 2.0 * self.cohesion(history) * self.cos_phi;
+        let scale = k.max(sigma.amax());
+        if sigma[0] < t - 1e-10 * scale {
+            return pyramid;
+        }
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-10 * scale;
+        let shear = pyramid != Regime::Elastic;
+        match (close(sigma[0], sigma[1]), close(sigma[1], sigma[2])) {
+            (true, true) => Regime::TensionApex,
+            (true, false) if shear => Regime::TensionCompressionEdge,
+            (true, false) => Regime::TensionEdge,
+            (false, true) if shear => Regime::TensionExtensionEdge,
+            _ if shear => Regime::TensionPlane,
+            _ => Regime::Tension,
+        }
     }
 }

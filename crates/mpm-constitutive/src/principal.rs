@@ -43,6 +43,23 @@ pub enum Regime {
     ExtensionEdge = 3,
     /// The apex: an isotropic stress.
     Apex = 4,
+    /// The tension cut-off of Mohr–Coulomb alone: the largest principal
+    /// stress at the tensile strength, $\tau_1 = \sigma_t$ (Rankine).
+    Tension = 5,
+    /// Mohr–Coulomb's main plane and the tension cut-off: $\tau_1 =
+    /// \sigma_t$ with $\tau_3$ on the main plane.
+    TensionPlane = 6,
+    /// The edge of two tension planes: $\tau_1 = \tau_2 = \sigma_t$.
+    TensionEdge = 7,
+    /// Mohr–Coulomb's triaxial-extension edge on the tension cut-off:
+    /// $\tau_1 = \sigma_t$, $\tau_2 = \tau_3$ on the main plane.
+    TensionExtensionEdge = 8,
+    /// Mohr–Coulomb's triaxial-compression edge on the tension edge:
+    /// $\tau_1 = \tau_2 = \sigma_t$, $\tau_3$ on the main plane.
+    TensionCompressionEdge = 9,
+    /// The apex of the tension cut-off: the isotropic stress $\sigma_t
+    /// \mathbf 1$.
+    TensionApex = 10,
 }
 
 impl Regime {
@@ -53,6 +70,12 @@ impl Regime {
             2 => Self::CompressionEdge,
             3 => Self::ExtensionEdge,
             4 => Self::Apex,
+            5 => Self::Tension,
+            6 => Self::TensionPlane,
+            7 => Self::TensionEdge,
+            8 => Self::TensionExtensionEdge,
+            9 => Self::TensionCompressionEdge,
+            10 => Self::TensionApex,
             _ => Self::Elastic,
         }
     }
