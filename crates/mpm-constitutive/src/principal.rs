@@ -83,7 +83,18 @@ impl Regime {
 
 /// Trial strains closer than this (relative to $\max(1,
 /// |\varepsilon|_\infty)$) count as repeated for the divided difference.
-pub const REPEATED: f64 = 1e-9;
+///
+/// Why 1e-6: the rounding of $\tau_a - \tau_b$ is amplified by the
+/// return's own conditioning (a Mohr–Coulomb edge at ν = 0.4999), so the
+/// quotient at $\varepsilon_a - \varepsilon_b = 1.9\times10^{-9}$ missed
+/// the finite differences by 7.2e-6 (the property test of 3000 random
+/// deformation gradients; it was 1e-9 then). Mohr–Coulomb's returns are
+/// affine in the trial strain within a regime and make $\tau_a = \tau_b$
+/// on an edge, so the limit is exact for them at any distance; for the
+/// cone of Drucker–Prager and Cam-Clay's ellipse it is off by
+/// $O(\varepsilon_a - \varepsilon_b)$, at most about 1e-6 relative here.
+/// With 1e-6 three runs of 3000 cases of every law's property tests pass.
+pub const REPEATED: f64 = 1e-6;
 
 /// The permutation sorting principal values in descending order:
 /// `values[order[0]] >= values[order[1]] >= values[order[2]]`.
