@@ -454,6 +454,10 @@ const SLOPE_BY_DISPLACEMENT: [&str; 3] = [
     "strength_reduction.displacement_limit=0.05",
 ];
 
+/// A Mohr–Coulomb material's keys with a tension cut-off, for the valid
+/// scene's block.
+const SOIL_WITH_CUTOFF: &str = "model = \"mohr_coulomb\"\ncohesion = 1e3\nfriction_angle = 30.0\ndilation_angle = 5.0\ntension_cutoff = 5e2";
+
 /// A minimal valid 2D scene, mutated by the table below.
 const VALID: &str = r#"[mesh]
 origin = [0.0, 0.0]
@@ -489,8 +493,7 @@ steps = 2
 /// a Hencky layer under a Mohr–Coulomb one.
 #[test]
 fn soil_materials_run_from_a_scene() {
-    let soil =
-        "model = \"mohr_coulomb\"\ncohesion = 1e3\nfriction_angle = 30.0\ndilation_angle = 5.0";
+    let soil = SOIL_WITH_CUTOFF;
     let dp =
         "model = \"drucker_prager\"\nmatching = \"inner\"\ncohesion = 1e3\nfriction_angle = 30.0";
     for model in [soil, dp] {
@@ -944,6 +947,16 @@ fn malformed_scenes_are_refused_with_a_located_message() {
         ),
         (
             "model = \"hencky\"",
+            "model = \"drucker_prager\"\nmatching = \"outer\"\ncohesion = 1e3\nfriction_angle = 30.0\ntension_cutoff = 1e3",
+            "bad.toml:12:18: material `m`: tension_cutoff applies to model = mohr_coulomb",
+        ),
+        (
+            "model = \"hencky\"",
+            "model = \"mohr_coulomb\"\ncohesion = 1e3\nfriction_angle = 30.0\ntension_cutoff = 1e4",
+            "tensile strength = 10000 must be",
+        ),
+        (
+            "model = \"hencky\"",
             "model = \"hencky\"\noverconsolidation_ratio = 2.0",
             "bad.toml:9:27: material `m`: overconsolidation_ratio applies to model = modified_cam_clay",
         ),
@@ -1346,6 +1359,7 @@ fn every_documented_key_is_exercised() {
         GEOSTATIC,
         include_str!("../../../scenes/griffiths_lane_slope.toml"),
         include_str!("../../../scenes/triaxial_cam_clay.toml"),
+        SOIL_WITH_CUTOFF,
         // The displacement criterion's keys, as the slope's test sets them.
         &SLOPE_BY_DISPLACEMENT
             .map(|s| s.replace("strength_reduction.", "").replace('=', " = "))

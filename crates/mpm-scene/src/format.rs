@@ -293,6 +293,10 @@ pub struct MaterialSpec {
     /// `plane_strain`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub matching: Option<Spanned<ConeMatching>>,
+    /// `mohr_coulomb`: the tension cut-off σ_t (Pa, ≥ 0, at most c cot φ):
+    /// no principal stress above it (Rankine). Default: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tension_cutoff: Option<Spanned<f64>>,
     /// `modified_cam_clay`: the slope λ̂ of the normal compression line in
     /// ln p against the volumetric log strain (> κ̂).
     #[serde(default, skip_serializing_if = "Option::is_none")]

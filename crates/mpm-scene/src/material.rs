@@ -41,6 +41,8 @@ pub struct MaterialParams {
     pub dilation_angle: f64,
     /// How the Drucker–Prager cone matches Mohr–Coulomb.
     pub matching: Option<ConeMatching>,
+    /// Mohr–Coulomb's tension cut-off σ_t (Pa).
+    pub tension_cutoff: Option<f64>,
     /// Modified Cam-Clay's constants.
     pub cam_clay: Option<CamClayParams>,
 }
@@ -99,6 +101,7 @@ impl MaterialParams {
             friction_angle: None,
             dilation_angle: 0.0,
             matching: None,
+            tension_cutoff: None,
             cam_clay: None,
         }
     }
@@ -116,6 +119,16 @@ impl MaterialParams {
             yield_stress: self.yield_stress.map(|y| y / factor),
             hardening: self.hardening / factor,
             cohesion: self.cohesion.map(|c| c / factor),
+            // The apex c cot φ is the same for the reduced strength; the
+            // cut-off must stay below it when F < 1 raises σ_t.
+            tension_cutoff: self.tension_cutoff.map(|t| {
+                match (self.cohesion, self.friction_angle) {
+                    (Some(c), Some(phi)) if phi > 0.0 => {
+                        (t / factor).min(c / phi.to_radians().tan())
+                    }
+                    _ => t / factor,
+                }
+            }),
             friction_angle: phi,
             dilation_angle: phi.map_or(self.dilation_angle, |p| self.dilation_angle.min(p)),
             ..*self
@@ -451,7 +464,11 @@ register_laws! {
     /// Souza Neto et al. 2008 §8.2).
     MohrCoulomb => "mohr_coulomb", MohrCoulomb, |p| {
         let (c, phi, psi) = strength(p, "mohr_coulomb")?;
-        MohrCoulomb::new(p.youngs_modulus, p.poisson_ratio, c, phi, psi, p.hardening)
+        let law = MohrCoulomb::new(p.youngs_modulus, p.poisson_ratio, c, phi, psi, p.hardening)?;
+        match p.tension_cutoff {
+            Some(t) => law.with_tension_cutoff(t),
+            None => Ok(law),
+        }
     };
     /// Drucker–Prager matched to Mohr–Coulomb (de Souza Neto et al. 2008
     /// §8.3).
@@ -648,6 +665,7 @@ mod tests {
             friction_angle: Some(30.0),
             dilation_angle: 25.0,
             matching: Some(ConeMatching::Inner),
+            tension_cutoff: Some(5e3),
             ..params(None)
         };
         let factor = 1.37;
@@ -662,7 +680,9 @@ mod tests {
                 "{sa} {sb}"
             );
         };
-        let mc = MohrCoulomb::new(1e6, 0.3, 1e4, 30.0, 25.0, 2e4).expect("law");
+        let mc = MohrCoulomb::new(1e6, 0.3, 1e4, 30.0, 25.0, 2e4)
+            .and_then(|l| l.with_tension_cutoff(5e3))
+            .expect("law");
         same(
             SceneLaw::new(MaterialModel::MohrCoulomb, &reduced).expect("law"),
             SceneLaw::MohrCoulomb(mc.reduced(factor).expect("law")),

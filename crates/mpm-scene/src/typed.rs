@@ -254,6 +254,7 @@ impl MaterialSpec {
             friction_angle: None,
             dilation_angle: None,
             matching: None,
+            tension_cutoff: None,
             compression_index: None,
             swelling_index: None,
             critical_state_slope: None,

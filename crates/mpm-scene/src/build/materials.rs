@@ -50,6 +50,7 @@ pub(super) fn materials(
             friction_angle: spec.friction_angle.as_ref().map(|v| *v.get_ref()),
             dilation_angle: spec.dilation_angle.as_ref().map_or(0.0, |v| *v.get_ref()),
             matching: spec.matching.as_ref().map(|v| *v.get_ref()),
+            tension_cutoff: spec.tension_cutoff.as_ref().map(|v| *v.get_ref()),
             cam_clay,
         };
         if spec.model != MaterialModel::VonMises && spec.yield_stress.is_some() {
@@ -178,6 +179,14 @@ fn check_soil_keys(spec: &MaterialSpec, src: &SceneSource) -> Result<(), SceneEr
             }
             _ => {}
         }
+    }
+    if let Some(t) = &spec.tension_cutoff
+        && model != MaterialModel::MohrCoulomb
+    {
+        return Err(src.at(
+            t,
+            format!("material `{name}`: tension_cutoff applies to model = mohr_coulomb"),
+        ));
     }
     if let Some(m) = &spec.matching
         && model != MaterialModel::DruckerPrager
