@@ -36,6 +36,20 @@ fn scene_named(name: &str) -> PathBuf {
         .join(name)
 }
 
+/// A session directory of Open MPI's own for one `mpirun` job (the
+/// `orte_tmpdir_base` MCA parameter): jobs started side by side by the
+/// test harness otherwise share `/tmp/ompi.<host>.<uid>`, and one job's
+/// cleanup removed it while another was creating its own part of it
+/// ("A call to mkdir was unable to create the desired directory", a CI
+/// run of 2026-12-07).
+fn ompi_session_dir() -> std::path::PathBuf {
+    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("mpm-ompi-{}-{k}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a session directory for mpirun");
+    dir
+}
+
 /// Starts `mpm run` with `args` on `n` processes (`n` = 0: without
 /// mpirun), in a process group of its own.
 fn start(n: usize, args: &[&str]) -> Child {
@@ -44,7 +58,8 @@ fn start(n: usize, args: &[&str]) -> Child {
         Command::new(exe)
     } else {
         let mut c = Command::new("mpirun");
-        c.args(["-n", &n.to_string(), "--oversubscribe", exe]);
+        c.args(["-n", &n.to_string(), "--oversubscribe", exe])
+            .env("OMPI_MCA_orte_tmpdir_base", ompi_session_dir());
         c
     };
     command

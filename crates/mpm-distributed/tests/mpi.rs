@@ -26,6 +26,20 @@ const BOUND: f64 = 1e-12;
 /// A job that has not ended in this time hangs.
 const DEADLINE: Duration = Duration::from_secs(120);
 
+/// A session directory of Open MPI's own for one `mpirun` job (the
+/// `orte_tmpdir_base` MCA parameter): jobs started side by side by the
+/// test harness otherwise share `/tmp/ompi.<host>.<uid>`, and one job's
+/// cleanup removed it while another was creating its own part of it
+/// ("A call to mkdir was unable to create the desired directory", a CI
+/// run of 2026-12-07).
+fn ompi_session_dir() -> std::path::PathBuf {
+    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("mpm-ompi-{}-{k}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a session directory for mpirun");
+    dir
+}
+
 /// Runs the child test `name` on `n` processes; the output once it ends.
 fn mpirun(n: usize, name: &str) -> Output {
     let exe = std::env::current_exe().unwrap();
@@ -43,6 +57,7 @@ fn mpirun(n: usize, name: &str) -> Output {
         .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
+        .env("OMPI_MCA_orte_tmpdir_base", ompi_session_dir())
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
