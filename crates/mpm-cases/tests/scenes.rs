@@ -447,6 +447,69 @@ fn a_cam_clay_triaxial_cell_follows_the_undrained_path() {
     );
 }
 
+/// Strength reduction of an undrained (φ = 0) slope: the Griffiths & Lane
+/// geometry in Tresca soil (`mohr_coulomb` with φ = 0, c = 50 kPa), and
+/// in von Mises soil of the same plane-strain strength (ρ_y = √2 c, the
+/// yield stress strength reduction divides). A perfectly plastic body's
+/// collapse load does not depend on its stiffness, so the factor of
+/// safety of a φ = 0 slope is proportional to c (Taylor's stability
+/// number c/(FγH) is a constant of the geometry): doubling c must double
+/// F within the bisection's resolution, the two brackets' widths (0.0078
+/// each) relative to F — 0.0055. Measured: F = 2.1367 and 4.2773 (ratio
+/// 2.0017), von Mises 2.1523.
+#[test]
+fn an_undrained_slope_has_a_factor_of_safety_proportional_to_its_strength() {
+    let text = include_str!("../../../scenes/griffiths_lane_slope.toml")
+        .replace("friction_angle = 20.0", "friction_angle = 0.0");
+    let run = |text: &str, test: &str| -> (f64, f64) {
+        let dir = common::fresh_dir(test);
+        let scene = dir.join("scene.toml");
+        std::fs::write(&scene, text).unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_mpm"))
+            .arg("run")
+            .arg(&scene)
+            .arg("--out")
+            .arg(dir.join("out"))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+                .unwrap();
+        let sr = &summary["strength_reduction"];
+        let f = |k: &str| sr[k].as_f64().unwrap();
+        (f("factor_of_safety"), f("first_failed") - f("last_held"))
+    };
+    let (f1, w1) = run(
+        &text.replace("cohesion = 1.0e4", "cohesion = 5.0e4"),
+        "slope_tresca_c",
+    );
+    let (f2, w2) = run(
+        &text.replace("cohesion = 1.0e4", "cohesion = 1.0e5"),
+        "slope_tresca_2c",
+    );
+    let von_mises = text
+        .replace("model = \"mohr_coulomb\"", "model = \"von_mises\"")
+        .replace(
+            "cohesion = 1.0e4\nfriction_angle = 0.0\ndilation_angle = 0.0",
+            "yield_stress = 70710.67811865475",
+        );
+    let (fv, _) = run(&von_mises, "slope_von_mises");
+    println!(
+        "undrained slope: F = {f1:.4} (c), {f2:.4} (2c), ratio {:.4}; von Mises {fv:.4}",
+        f2 / f1
+    );
+    assert!(
+        (f2 / (2.0 * f1) - 1.0).abs() <= w1 / f1 + w2 / f2,
+        "{f1} and {f2}"
+    );
+    assert!(fv > 1.0 && fv.is_finite(), "von Mises: {fv}");
+}
+
 /// The Griffiths & Lane slope's overrides for the displacement criterion.
 const SLOPE_BY_DISPLACEMENT: [&str; 3] = [
     "strength_reduction.criterion=displacement",
