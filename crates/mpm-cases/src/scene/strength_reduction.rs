@@ -151,47 +151,46 @@ where
         ..RunControl::default()
     };
     let start = Instant::now();
-    let mut last: Option<crate::run::Snapshot> = None;
-    let mut mechanism = None;
+    // The last two converged steps' displacements; the last step's points.
+    let mut displaced: [Vec<[f64; 3]>; 2] = [Vec::new(), Vec::new()];
+    let mut points: Option<(Vec<[f64; 3]>, Vec<f64>)> = None;
     let mut load_factor = 0.0;
     let (mut steps, mut iterations) = (0, 0);
     let result = crate::scene::run(&reduced, &control, |_, report, snap| {
         steps += 1;
         iterations += report.iterations();
-        let before = last.as_ref().map(|s| s.displacement.as_slice());
-        let zero = [0.0; 3];
-        mechanism = Some(Mechanism {
-            position: snap.position.clone(),
-            volume: snap.volume.clone(),
-            step_displacement: snap
-                .displacement
-                .iter()
-                .enumerate()
-                .map(|(p, u)| distance(u, before.map_or(&zero, |b| &b[p])))
-                .collect(),
-        });
         load_factor = report.lambda1;
-        last = Some(snap.clone());
+        displaced.swap(0, 1);
+        displaced[1].clone_from(&snap.displacement);
+        let (position, volume) = points.get_or_insert_with(Default::default);
+        position.clone_from(&snap.position);
+        volume.clone_from(&snap.volume);
         Ok(())
     });
-    let displacement =
-        |s: &crate::run::Snapshot| probe.map_or(0.0, |p| distance(&s.displacement[p], &[0.0; 3]));
+    let [before, last] = displaced;
+    let displacement = probe.map_or(0.0, |p| last.get(p).map_or(0.0, |u| distance(u, &[0.0; 3])));
     let failure = match &result {
-        Ok(out) => match sr.failure {
-            Failure::Displacement { limit, .. } if displacement(&out.last) > limit => {
-                Some(format!(
-                    "the probe moved {:.4e} m > {limit:e} m",
-                    displacement(&out.last)
-                ))
-            }
+        Ok(_) => match sr.failure {
+            Failure::Displacement { limit, .. } if displacement > limit => Some(format!(
+                "the probe moved {displacement:.4e} m > {limit:e} m"
+            )),
             _ => None,
         },
         Err(e) if is_failure(e) => Some(e.to_string()),
         Err(e) => return Err(e.clone().into()),
     };
+    let mechanism = points.map(|(position, volume)| Mechanism {
+        position,
+        volume,
+        step_displacement: last
+            .iter()
+            .enumerate()
+            .map(|(p, u)| distance(u, before.get(p).unwrap_or(&[0.0; 3])))
+            .collect(),
+    });
     Ok(Trial {
         factor,
-        displacement: last.as_ref().map_or(0.0, displacement),
+        displacement,
         load_factor,
         failure,
         steps,
