@@ -115,6 +115,18 @@ use crate::spectral::SymSpectral;
 use crate::tensor::Tensor4;
 use crate::von_mises::YIELD_TOLERANCE;
 
+/// The tensile strength of a strength-reduction trial at `factor`:
+/// $\sigma_t/F$, capped at the pyramid's apex $c_0\cot\phi$ (`apex`,
+/// `None` for $\phi = 0$), which the reduction does not move
+/// ($(c_0/F)\cot\phi_F = c_0\cot\phi$): for $F \ge 1$ the reduced
+/// cut-off still cuts the apex, for $F < 1$ (a strength increase) it would
+/// not without the cap. [`MohrCoulomb::reduced`] and the scene's reduced
+/// parameters share this rule.
+pub fn reduced_tensile_strength(tension: f64, apex: Option<f64>, factor: f64) -> f64 {
+    let reduced = tension / factor;
+    apex.map_or(reduced, |apex| reduced.min(apex))
+}
+
 /// Relative rounding by which a tensile strength may exceed the apex
 /// $c_0\cot\phi$ ([`MohrCoulomb::with_tension_cutoff`]).
 pub const APEX_SLACK: f64 = 1e-12;
@@ -231,8 +243,7 @@ impl MohrCoulomb {
         let Some(tension) = self.tension else {
             return Ok(law);
         };
-        let reduced = tension / factor;
-        law.with_tension_cutoff(law.apex_bound().map_or(reduced, |apex| reduced.min(apex)))
+        law.with_tension_cutoff(reduced_tensile_strength(tension, law.apex_bound(), factor))
     }
 
     /// [`Self::reduced`] without the cut-off.

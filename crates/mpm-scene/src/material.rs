@@ -119,15 +119,12 @@ impl MaterialParams {
             yield_stress: self.yield_stress.map(|y| y / factor),
             hardening: self.hardening / factor,
             cohesion: self.cohesion.map(|c| c / factor),
-            // The apex c cot φ is the same for the reduced strength; the
-            // cut-off must stay below it when F < 1 raises σ_t.
             tension_cutoff: self.tension_cutoff.map(|t| {
-                match (self.cohesion, self.friction_angle) {
-                    (Some(c), Some(phi)) if phi > 0.0 => {
-                        (t / factor).min(c / phi.to_radians().tan())
-                    }
-                    _ => t / factor,
-                }
+                let apex = match (self.cohesion, self.friction_angle) {
+                    (Some(c), Some(phi)) if phi > 0.0 => Some(c / phi.to_radians().tan()),
+                    _ => None,
+                };
+                mpm_constitutive::mohr_coulomb::reduced_tensile_strength(t, apex, factor)
             }),
             friction_angle: phi,
             dilation_angle: phi.map_or(self.dilation_angle, |p| self.dilation_angle.min(p)),
