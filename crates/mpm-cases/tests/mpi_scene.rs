@@ -272,7 +272,7 @@ fn petsc_over_2_processes_takes_the_direct_solvers_steps() {
 
 /// The explicit column on 2 processes: the same outputs, the energies
 /// (`energy.csv`: time, kinetic, strain, gravitational, external work,
-/// total) within 1e-10 of the largest (issue 42; the thread ranks of
+/// friction and wall work, total) within 1e-10 of the largest (issue 42; the thread ranks of
 /// `tests/explicit_ranks.rs` measure 1e-15); stopped and resumed, the
 /// same files byte for byte.
 #[test]

@@ -68,7 +68,7 @@ use mpm_mesh::RegularGrid;
 use mpm_scene::body::InitialDomain;
 use mpm_solver::explicit::{
     DilatationTreatment, Energies, ExplicitStageTimes, PointsFor, PointsOf, StepInfo,
-    VelocityGradient,
+    VelocityGradient, WallWork,
 };
 use mpm_solver::{
     CellAveraged, DomainUpdater, ExplicitOptions, ExplicitPoints, ExplicitSolver, Flat, FlipPic,
@@ -539,6 +539,7 @@ where
             c.state.summary.steps,
             clock.external_work,
         );
+        self.solver.resume_wall_work(clock.wall_work);
         Ok(())
     }
 
@@ -763,6 +764,7 @@ impl<const D: usize> Outputs<'_, '_, D> {
         let clock = Clock {
             index: 0,
             external_work: 0.0,
+            wall_work: WallWork::default(),
             initial: energies,
             scale: energies.kinetic + energies.strain,
         };
@@ -787,6 +789,10 @@ impl<const D: usize> Outputs<'_, '_, D> {
     ) -> Result<(), SolverError> {
         clock.index += 1;
         clock.external_work = at.external_work;
+        clock.wall_work = WallWork {
+            friction: at.energies.friction_work,
+            impact: at.energies.wall_work,
+        };
         clock.scale = clock.scale.max(at.energies.kinetic + at.energies.strain);
         self.frame(run, at, clock, wall)
     }
@@ -962,18 +968,20 @@ impl Wall {
 }
 
 /// What an explicit checkpoint keeps besides the points and the step
-/// count: the output reached, the work of the applied forces, the initial
-/// energies and the energy scale (in [`Checkpoint::case_state`]).
+/// count: the output reached, the work of the applied forces, what the
+/// friction walls took, the initial energies and the energy scale (in
+/// [`Checkpoint::case_state`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Clock {
     index: usize,
     external_work: f64,
+    wall_work: WallWork,
     initial: Energies,
     scale: f64,
 }
 
 impl Clock {
-    pub(crate) const LEN: usize = 7;
+    pub(crate) const LEN: usize = 9;
 
     fn to_case_state(self) -> Vec<f64> {
         let e = self.initial;
@@ -985,6 +993,8 @@ impl Clock {
             e.gravitational,
             e.external_work,
             self.scale,
+            self.wall_work.friction,
+            self.wall_work.impact,
         ]
     }
 
@@ -999,13 +1009,19 @@ impl Clock {
         Ok(Self {
             index: s[0] as usize,
             external_work: s[1],
+            // Output 0, where a run starts, has taken nothing at its walls.
             initial: Energies {
                 kinetic: s[2],
                 strain: s[3],
                 gravitational: s[4],
                 external_work: s[5],
+                ..Energies::default()
             },
             scale: s[6],
+            wall_work: WallWork {
+                friction: s[7],
+                impact: s[8],
+            },
         })
     }
 }

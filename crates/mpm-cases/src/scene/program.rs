@@ -410,6 +410,8 @@ fn energies_json(e: &mpm_solver::explicit::Energies) -> Value {
         "strain": e.strain,
         "gravitational": e.gravitational,
         "external_work": e.external_work,
+        "friction_work": e.friction_work,
+        "wall_work": e.wall_work,
         "total": e.total(),
     })
 }
@@ -446,12 +448,14 @@ where
     let mut rebalances = Vec::new();
     obs.show_time();
     obs.writer.set_vtu_options(vtu_options(problem, true));
-    const ENERGY_HEADER: [&str; 6] = [
+    const ENERGY_HEADER: [&str; 8] = [
         "time",
         "kinetic",
         "strain",
         "gravitational",
         "external_work",
+        "friction_work",
+        "wall_work",
         "total",
     ];
     let axes = ["x", "y", "z"];
@@ -482,6 +486,8 @@ where
                 e.strain,
                 e.gravitational,
                 e.external_work,
+                e.friction_work,
+                e.wall_work,
                 e.total(),
             ]
             .map(CsvValue::from);

@@ -17,13 +17,29 @@ pub struct Energies {
     pub gravitational: f64,
     /// Work of the applied point forces since the start.
     pub external_work: f64,
+    /// Energy dissipated by the friction walls since the start
+    /// ([`super::WallWork::friction`]).
+    pub friction_work: f64,
+    /// Energy lost in impacts on the friction walls since the start
+    /// ([`super::WallWork::impact`]).
+    pub wall_work: f64,
 }
 
 impl Energies {
-    /// Kinetic + strain + gravitational − external work: constant for a
-    /// conservative scheme.
+    /// Kinetic + strain + gravitational + what the friction walls took −
+    /// external work: constant for a conservative scheme.
     pub fn total(&self) -> f64 {
-        self.kinetic + self.strain + self.gravitational - self.external_work
+        self.kinetic + self.strain + self.gravitational + self.friction_work + self.wall_work
+            - self.external_work
+    }
+
+    /// The same energies with what the friction walls took so far.
+    pub fn with_wall_work(self, work: super::WallWork) -> Self {
+        Self {
+            friction_work: work.friction,
+            wall_work: work.impact,
+            ..self
+        }
     }
 }
 

@@ -1,9 +1,16 @@
-//! Prescribed nodal velocities (MPoint notes, below eq. 32).
+//! Prescribed nodal velocities (MPoint notes, below eq. 32) and Coulomb
+//! friction walls on grid faces (Bardenhagen, Brackbill & Sulsky 2000).
 
 /// Nodal velocity fixities: after the grid update (eq. 32) the listed
 /// components are set, $\tilde v_i^{n+1} = v^{fix}_i$, and their
 /// acceleration recomputed as $(\tilde v_i^{n+1} - v_i^n)/\Delta t$. A slip
 /// wall fixes the normal component to zero; a clamp fixes all.
+///
+/// Friction walls ([`VelocityFixities::friction`]) are applied in the same
+/// place, after the prescribed components ([`super::grid_update::update`]):
+/// a node of a wall that moves into it loses its normal velocity and, by
+/// Coulomb's law, up to μ times that in tangential velocity; a node that
+/// moves away is left free.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct VelocityFixities {
     /// (node, component, velocity), in the order given until
@@ -12,6 +19,39 @@ pub struct VelocityFixities {
     /// Bit `c` of entry `n`: component `c` of node `n` is held (built by
     /// [`VelocityFixities::finish`]).
     mask: Vec<u8>,
+    /// The friction walls, in the order given until
+    /// [`VelocityFixities::finish`] sorts them by node and face, drops
+    /// repeats (the later kept) and those whose normal component is held.
+    walls: Vec<FrictionWall>,
+}
+
+/// One node of a rigid, fixed wall with Coulomb friction: the wall lies
+/// beyond the grid face normal to `axis` (the face at the upper end of the
+/// axis when `upper`), so its outward normal is $\mathbf n = \pm\mathbf
+/// e_{axis}$.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrictionWall {
+    /// The node.
+    pub node: usize,
+    /// The axis normal to the wall.
+    pub axis: usize,
+    /// Whether the wall is at the upper end of `axis` ($\mathbf n = +\mathbf
+    /// e_{axis}$) or the lower ($-\mathbf e_{axis}$).
+    pub upper: bool,
+    /// The Coulomb coefficient μ ≥ 0 (0: a slip wall that lets go).
+    pub mu: f64,
+    /// Bit `c`: component `c` is tangential and not held, so friction acts
+    /// on it (set by [`VelocityFixities::finish`]).
+    tangential: u8,
+}
+
+impl FrictionWall {
+    /// The components friction acts on: those tangential to the wall that
+    /// no fixity holds (after [`VelocityFixities::finish`]).
+    #[inline]
+    pub fn slides(&self, component: usize) -> bool {
+        component < 8 && self.tangential >> component & 1 == 1
+    }
 }
 
 impl VelocityFixities {
@@ -38,9 +78,33 @@ impl VelocityFixities {
         self
     }
 
+    /// Makes `nodes` nodes of a friction wall with coefficient `mu` beyond
+    /// the grid face normal to `axis` (the upper face of the axis when
+    /// `upper`); a later wall on the same node and face replaces the
+    /// earlier. A wall acts on the components no fixity holds: where a
+    /// fixity holds its normal component the node is held, not a wall.
+    pub fn friction(
+        &mut self,
+        nodes: impl IntoIterator<Item = usize>,
+        axis: usize,
+        upper: bool,
+        mu: f64,
+    ) -> &mut Self {
+        self.walls
+            .extend(nodes.into_iter().map(|node| FrictionWall {
+                node,
+                axis,
+                upper,
+                mu,
+                tangential: 0,
+            }));
+        self
+    }
+
     /// Sorts the fixities by node and component, a later value of a
-    /// repeated component replacing the earlier one (the solver calls it
-    /// once when it takes the fixities; calling it again changes nothing).
+    /// repeated component replacing the earlier one, and the walls by
+    /// node and face alike (the solver calls it once when it takes the
+    /// fixities; calling it again changes nothing).
     pub fn finish(&mut self) {
         // Stable sort keeps the last value of a repeated component last.
         self.entries.sort_by_key(|&(n, c, _)| (n, c));
@@ -63,6 +127,30 @@ impl VelocityFixities {
                 self.mask[n] |= 1 << c;
             }
         }
+        self.finish_walls();
+    }
+
+    /// The walls sorted by node and face, the later of a repeated one
+    /// kept, those whose normal component a fixity holds dropped, and
+    /// each one's sliding components marked.
+    fn finish_walls(&mut self) {
+        self.walls.sort_by_key(|w| (w.node, w.axis, w.upper));
+        let mut out: Vec<FrictionWall> = Vec::with_capacity(self.walls.len());
+        for w in self.walls.drain(..) {
+            match out.last_mut() {
+                Some(last) if (last.node, last.axis, last.upper) == (w.node, w.axis, w.upper) => {
+                    *last = w;
+                }
+                _ => out.push(w),
+            }
+        }
+        out.retain(|w| self.held(w.node, w.axis).is_none());
+        for w in &mut out {
+            w.tangential = (0..8)
+                .filter(|&c| c != w.axis && self.held(w.node, c).is_none())
+                .fold(0, |bits, c| bits | 1 << c);
+        }
+        self.walls = out;
     }
 
     /// The prescribed velocity of component `component` of `node`, if it is
@@ -86,12 +174,18 @@ impl VelocityFixities {
         &self.entries
     }
 
+    /// The friction walls: sorted by node and face after
+    /// [`VelocityFixities::finish`], in the order given before.
+    pub fn walls(&self) -> &[FrictionWall] {
+        &self.walls
+    }
+
     /// Number of fixed components.
     pub fn len(&self) -> usize {
         self.entries.len()
     }
 
-    /// Whether nothing is fixed.
+    /// Whether nothing is fixed (friction walls aside).
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }
@@ -113,5 +207,32 @@ mod tests {
         for (n, c) in [(1, 1), (0, 0), (2, 0), (3, 2), (4, 0), (3, 9)] {
             assert_eq!(f.held(n, c), None, "({n}, {c})");
         }
+    }
+
+    /// A later wall on a node's face replaces the earlier; a wall whose
+    /// normal a fixity holds is dropped; held tangential components do
+    /// not slide.
+    #[test]
+    fn walls_keep_the_later_and_yield_to_held_components() {
+        let mut f = VelocityFixities::new();
+        f.friction([4, 2, 7], 1, false, 0.1)
+            .friction([4], 1, false, 0.3)
+            .friction([4], 0, true, 0.2)
+            .fix([2], 1)
+            .fix([7], 0);
+        f.finish();
+        let walls: Vec<_> = f
+            .walls()
+            .iter()
+            .map(|w| (w.node, w.axis, w.upper, w.mu))
+            .collect();
+        assert_eq!(
+            walls,
+            [(4, 0, true, 0.2), (4, 1, false, 0.3), (7, 1, false, 0.1)]
+        );
+        let [a, b, c] = f.walls() else { panic!() };
+        assert!(!a.slides(0) && a.slides(1) && a.slides(2));
+        assert!(b.slides(0) && !b.slides(1));
+        assert!(!c.slides(0) && !c.slides(1) && c.slides(2));
     }
 }

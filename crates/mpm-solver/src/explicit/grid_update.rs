@@ -1,32 +1,60 @@
 //! Stage 2, the grid update: nodal velocity (eq. 30), acceleration (eq.
-//! 31), updated velocity (eq. 32) and the velocity fixities.
+//! 31), updated velocity (eq. 32), the velocity fixities and the friction
+//! walls.
 
 use rayon::prelude::*;
 
-use super::fixities::VelocityFixities;
+use super::fixities::{FrictionWall, VelocityFixities};
 use super::grid::{GridBuffer, NodeSums};
 pub use super::grid::{GridState, NodeVelocity};
 
 /// Nodes per parallel task of the grid update.
 const NODES_PER_TASK: usize = 4096;
 
+/// The energy the friction walls took from the grid (J; per unit
+/// thickness in 2D), both parts positive.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct WallWork {
+    /// Dissipated by friction: per sliding node the friction impulse
+    /// times the tangential velocity it leaves,
+    /// $m_i\,\|\mathbf v_t'\|\,(\|\mathbf v_t\| - \|\mathbf v_t'\|)$.
+    pub friction: f64,
+    /// Lost in the impacts: per node the wall stops, the kinetic energy of
+    /// the normal velocity it brought to the step,
+    /// $\tfrac12 m_i(\mathbf v^n_i\cdot\mathbf n)^2$.
+    pub impact: f64,
+}
+
+impl WallWork {
+    /// Both parts added.
+    pub fn plus(self, other: Self) -> Self {
+        Self {
+            friction: self.friction + other.friction,
+            impact: self.impact + other.impact,
+        }
+    }
+}
+
 /// Sums the threads' `buffers` into `grid` and updates the velocities
 /// (eqs. 30–32); nodes without mass get zero velocity. Then the fixities:
 /// $\tilde v^{n+1}_i$ is set to the prescribed value, which recomputes the
 /// acceleration as the notes require (a fixity on a node without mass has
-/// no effect: no point reads it).
+/// no effect: no point reads it); then the friction walls
+/// ([`friction_walls`]). Returns what the walls took from the nodes for
+/// which `counted` is true (on several ranks, those the rank owns).
 pub fn update<const D: usize>(
     buffers: &[GridBuffer<D>],
     grid: &mut GridState<D>,
     dt: f64,
     fixities: &VelocityFixities,
-) {
+    counted: impl Fn(usize) -> bool,
+) -> WallWork {
     let lo = buffers.iter().map(|b| b.lo).min().unwrap_or(usize::MAX);
     let hi = buffers.iter().map(|b| b.hi).max().unwrap_or(0);
     if lo >= hi {
         grid.lo = 0;
         grid.hi = 0;
-        return;
+        return WallWork::default();
     }
     grid.lo = lo;
     grid.hi = hi;
@@ -67,6 +95,59 @@ pub fn update<const D: usize>(
             grid.velocity[node].new[component] = value;
         }
     }
+    friction_walls(grid, fixities.walls(), counted)
+}
+
+/// Coulomb friction against rigid, fixed walls at the nodes of `walls`
+/// (Bardenhagen, Brackbill & Sulsky 2000, their contact algorithm with the
+/// wall as the second body, of zero velocity): a node with mass whose
+/// updated velocity $\tilde{\mathbf v}$ moves into its wall, $\tilde v_n =
+/// \tilde{\mathbf v}\cdot\mathbf n > 0$ ($\mathbf n$ the wall's outward
+/// normal), loses that normal velocity, and its tangential velocity
+/// $\tilde{\mathbf v}_t$ (the components no fixity holds) shrinks by
+/// $\mu\tilde v_n$ — the impulse $\mu m_i\tilde v_n$, μ times the
+/// normal one — but not past zero (stick):
+/// $\mathbf v_t' = \tilde{\mathbf v}_t\,\max(0, 1 - \mu\tilde v_n/\|\tilde{\mathbf v}_t\|)$.
+/// A node that moves away from its wall, or along it, is left free: the
+/// wall lets go. Walls follow one another in their order (a corner node
+/// of two walls meets both). Returns the [`WallWork`] of the nodes for
+/// which `counted` is true.
+pub fn friction_walls<const D: usize>(
+    grid: &mut GridState<D>,
+    walls: &[FrictionWall],
+    counted: impl Fn(usize) -> bool,
+) -> WallWork {
+    let mut work = WallWork::default();
+    for w in walls {
+        let i = w.node;
+        if !(i >= grid.lo && i < grid.hi && grid.mass[i] > 0.0) {
+            continue;
+        }
+        let outward = if w.upper { 1.0 } else { -1.0 };
+        let v = &mut grid.velocity[i];
+        let approach = outward * v.new[w.axis];
+        if approach <= 0.0 {
+            continue;
+        }
+        v.new[w.axis] = 0.0;
+        let sliding = (0..D).filter(|&c| w.slides(c));
+        let speed = sliding
+            .clone()
+            .map(|c| v.new[c] * v.new[c])
+            .sum::<f64>()
+            .sqrt();
+        let left = (speed - w.mu * approach).max(0.0);
+        if speed > 0.0 {
+            let scale = left / speed;
+            sliding.for_each(|c| v.new[c] *= scale);
+        }
+        if counted(i) {
+            let m = grid.mass[i];
+            work.friction += m * left * (speed - left);
+            work.impact += 0.5 * m * (outward * v.old[w.axis]).powi(2);
+        }
+    }
+    work
 }
 
 /// Material-point fixities on the grid: the updated grid velocities are
@@ -155,4 +236,82 @@ pub fn hold_points_to<const D: usize>(
         }
     }
     worst
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::SVector;
+
+    use super::*;
+
+    /// One node of mass 2 on the floor of a 3D grid (the wall below it,
+    /// n = −e_z), its updated velocity `v`, and what the wall leaves.
+    fn on_floor(v: [f64; 3], mu: f64, old: [f64; 3]) -> (SVector<f64, 3>, WallWork) {
+        let mut grid = GridState::<3>::new(1);
+        grid.mass[0] = 2.0;
+        grid.velocity[0] = NodeVelocity {
+            old: SVector::from(old),
+            new: SVector::from(v),
+        };
+        grid.hi = 1;
+        let mut walls = VelocityFixities::new();
+        walls.friction([0], 2, false, mu);
+        walls.finish();
+        let work = friction_walls(&mut grid, walls.walls(), |_| true);
+        (grid.velocity[0].new, work)
+    }
+
+    /// Sliding: the normal approach 0.5 goes, the tangential speed 5
+    /// (along (3, 4)/5) drops by μ·0.5 = 0.1 in its own direction; the
+    /// friction work is m·|v_t'|·Δ|v_t|, the impact the old normal
+    /// velocity's energy.
+    #[test]
+    fn an_approaching_node_slides_with_coulomb_s_impulse() {
+        let (v, work) = on_floor([3.0, 4.0, -0.5], 0.2, [0.0, 0.0, -0.25]);
+        let expected = SVector::<f64, 3>::new(3.0, 4.0, 0.0) * (4.9 / 5.0);
+        assert!((v - expected).norm() < 1e-14, "{v}");
+        assert!((work.friction - 2.0 * 4.9 * 0.1).abs() < 1e-14);
+        assert!((work.impact - 0.5 * 2.0 * 0.0625).abs() < 1e-15);
+    }
+
+    /// Stick: μ·v_n beyond the tangential speed stops the node, and
+    /// static friction does no work.
+    #[test]
+    fn a_node_sticks_when_coulomb_s_impulse_suffices() {
+        let (v, work) = on_floor([0.03, -0.04, -0.5], 0.2, [0.0; 3]);
+        assert_eq!(v, SVector::<f64, 3>::zeros());
+        assert_eq!(work, WallWork::default());
+    }
+
+    /// A node moving away from the wall (or along it) is left as it is,
+    /// and μ = 0 removes the normal approach only.
+    #[test]
+    fn a_leaving_node_is_free_and_mu_zero_only_stops_the_approach() {
+        for v in [[1.0, 2.0, 0.5], [1.0, 2.0, 0.0]] {
+            let (after, work) = on_floor(v, 0.5, [0.0, 0.0, -1.0]);
+            assert_eq!(after, SVector::from(v));
+            assert_eq!(work, WallWork::default());
+        }
+        let (after, work) = on_floor([1.0, 2.0, -0.5], 0.0, [0.0; 3]);
+        assert_eq!(after, SVector::from([1.0, 2.0, 0.0]));
+        assert_eq!(work, WallWork::default());
+    }
+
+    /// On the upper face of x in 2D (n = +e_x) with y held by a fixity:
+    /// the normal goes, the held component is not friction's; a node of
+    /// another rank is not counted.
+    #[test]
+    fn held_components_do_not_slide_and_uncounted_nodes_book_nothing() {
+        let mut grid = GridState::<2>::new(1);
+        grid.mass[0] = 1.0;
+        grid.velocity[0].new = SVector::from([0.5, 3.0]);
+        grid.velocity[0].old = SVector::from([0.5, 3.0]);
+        grid.hi = 1;
+        let mut walls = VelocityFixities::new();
+        walls.friction([0], 0, true, 0.2).fix([0], 1);
+        walls.finish();
+        let work = friction_walls(&mut grid, walls.walls(), |_| false);
+        assert_eq!(grid.velocity[0].new, SVector::from([0.0, 3.0]));
+        assert_eq!(work, WallWork::default());
+    }
 }

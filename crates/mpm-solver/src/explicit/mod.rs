@@ -11,7 +11,7 @@
 //! 2. [`p2g::scatter`]: mass, momentum (Taylor term, eq. 29), forces
 //!    (eqs. 20–22), in parallel into per-thread [`p2g::GridBuffer`]s;
 //! 3. [`grid_update::update`]: the sum of the buffers, velocities (eqs.
-//!    30–32) and fixities;
+//!    30–32), fixities and friction walls;
 //! 4. [`g2p`]: velocity (eq. 36), position (eq. 37 corrected), velocity
 //!    gradient (eq. 38), optionally the cell-averaged dilatation (eqs.
 //!    47–53, [`CellAveraged`]), deformation gradient, volume (eqs. 39–41)
@@ -51,8 +51,8 @@ use nalgebra::{SMatrix, SVector};
 
 pub use dilatation::{CellAveraged, DilatationTreatment};
 pub use energy::Energies;
-pub use fixities::VelocityFixities;
-pub use grid_update::GridState;
+pub use fixities::{FrictionWall, VelocityFixities};
+pub use grid_update::{GridState, WallWork};
 pub use mesh::ExplicitMesh;
 pub use options::{ExplicitOptions, TimeStep};
 pub use p2g::GridBuffer;
@@ -205,6 +205,8 @@ where
     time: f64,
     steps: usize,
     external_work: f64,
+    /// What the friction walls took so far (over every rank).
+    wall_work: WallWork,
     stage_times: ExplicitStageTimes,
     fixed_start: Vec<f64>,
     /// The held points' (node, weight) pairs, and where each point's pairs end.
@@ -229,7 +231,8 @@ where
     ///
     /// # Errors
     /// Invalid options; a fixity on a node or component that does not
-    /// exist.
+    /// exist; a friction wall on a node or axis that does not exist or
+    /// with a coefficient that is negative or not finite.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         basis: B,
@@ -257,6 +260,16 @@ where
         {
             return Err(SolverError::InvalidInput(format!(
                 "velocity fixity ({n}, {c}) = {v}: the mesh has {node_count} nodes of {D} components and velocities must be finite"
+            )));
+        }
+        if let Some(w) = fixities
+            .walls()
+            .iter()
+            .find(|w| w.node >= node_count || w.axis >= D || !(w.mu.is_finite() && w.mu >= 0.0))
+        {
+            return Err(SolverError::InvalidInput(format!(
+                "friction wall at node {} normal to axis {} with μ = {}: the mesh has {node_count} nodes of {D} axes and μ must be finite and non-negative",
+                w.node, w.axis, w.mu
             )));
         }
         let node_position = if T::TAYLOR {
@@ -287,6 +300,7 @@ where
             time: 0.0,
             steps: 0,
             external_work: 0.0,
+            wall_work: WallWork::default(),
             stage_times: ExplicitStageTimes::default(),
             fixed_start: Vec::new(),
             held_stencils: (Vec::new(), Vec::new()),
@@ -335,6 +349,7 @@ where
             time: self.time,
             steps: self.steps,
             external_work: self.external_work,
+            wall_work: self.wall_work,
             stage_times: self.stage_times,
             fixed_start: self.fixed_start,
             held_stencils: self.held_stencils,
@@ -399,6 +414,19 @@ where
         self.steps = steps;
         self.external_work = external_work;
         self.max_signal = None;
+    }
+
+    /// What the friction walls took so far: the energy friction
+    /// dissipated and the energy lost in impacts on them (summed over the
+    /// ranks, the same on each).
+    pub fn wall_work(&self) -> WallWork {
+        self.wall_work
+    }
+
+    /// Sets what the friction walls took so far (a resumed run, as
+    /// [`Self::wall_work`] returned it when the checkpoint was written).
+    pub fn resume_wall_work(&mut self, work: WallWork) {
+        self.wall_work = work;
     }
 
     /// Wall time per stage so far.
@@ -470,7 +498,8 @@ where
         let updated = clock
             .time(Stage::Grid, || self.update_grid(points, dt))
             .map_err(|e| self.point_failure(&points.id, e));
-        self.collective(updated)?;
+        let walls = self.collective(updated)?;
+        self.wall_work = self.wall_work.plus(self.sum_wall_work(walls)?);
         clock.time(Stage::Grid, || self.hold_over_ranks(points))?;
         let work = self.point_force_power(points);
         let gathered = clock
@@ -544,19 +573,23 @@ where
     }
 
     /// The grid update (eq. 32) and the fixed points' velocities held on
-    /// the grid.
+    /// the grid; returns what the friction walls took at the nodes this
+    /// rank owns.
     fn update_grid(
         &mut self,
         points: &PointsOf<D, B, L, T>,
         dt: f64,
-    ) -> Result<(), (usize, PointFailure)> {
-        grid_update::update(&self.buffers, &mut self.grid, dt, &self.fixities);
+    ) -> Result<WallWork, (usize, PointFailure)> {
+        let owner = self.on_ranks.as_ref().map(OnRanks::owner_of_node);
+        let work = grid_update::update(&self.buffers, &mut self.grid, dt, &self.fixities, |i| {
+            owner.is_none_or(|(me, owners)| owners.get(i) == Some(&me))
+        });
         // On several ranks the stencils are rebuilt even when this rank
         // holds no point now (its held points may have migrated away).
         if !points.fixed_velocity.is_empty() || self.on_ranks.is_some() {
             self.hold_on_grid(points)?;
         }
-        Ok(())
+        Ok(work)
     }
 
     /// Points with prescribed velocity components move with them.
@@ -588,13 +621,15 @@ where
         Ok(self.steps - start)
     }
 
-    /// Kinetic, stored and gravitational energy of the points, and the
-    /// work of the applied point forces so far.
+    /// Kinetic, stored and gravitational energy of the points, the work
+    /// of the applied point forces so far and what the friction walls
+    /// took.
     ///
     /// # Errors
     /// A law without a stored energy.
     pub fn energies(&self, points: &PointsOf<D, B, L, T>) -> Result<Energies, SolverError> {
-        let local = energy::energies(&self.law, &self.options.gravity, points, self.external_work);
+        let local = energy::energies(&self.law, &self.options.gravity, points, self.external_work)
+            .map(|e| e.with_wall_work(self.wall_work));
         let Some(on) = &self.on_ranks else {
             return local;
         };
@@ -607,6 +642,7 @@ where
             strain,
             gravitational,
             external_work,
+            ..e
         })
     }
 

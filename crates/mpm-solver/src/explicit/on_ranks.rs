@@ -9,7 +9,8 @@ use mpm_constitutive::IncrementalLaw;
 
 use super::grid::GridState;
 use super::{
-    DilatationTreatment, ExplicitMesh, ExplicitSolver, PointsOf, Transfer, grid_update, migrate,
+    DilatationTreatment, ExplicitMesh, ExplicitSolver, PointsOf, Transfer, WallWork, grid_update,
+    migrate,
 };
 use crate::checkpoint::Flat;
 use crate::domain::DomainUpdater;
@@ -26,6 +27,15 @@ pub(super) struct OnRanks {
     /// Whether any rank holds material points (their fixities stay with
     /// them, so this is asked once).
     any_held: Option<bool>,
+}
+
+impl OnRanks {
+    /// This rank and the owner of every node: every rank that touches a
+    /// node holds its totals after the halo, so a sum over nodes counts
+    /// each on its owner alone.
+    pub(super) fn owner_of_node(&self) -> (usize, &[usize]) {
+        (self.ranks.rank(), &self.layout.owner_of_node)
+    }
 }
 
 impl<const D: usize, B, L, T, K, R> ExplicitSolver<D, B, L, T, K, R>
@@ -173,6 +183,28 @@ where
             }
         }
         Ok(())
+    }
+
+    /// The step's [`WallWork`] of this rank's own nodes summed over the
+    /// ranks (one reduction, in runs with friction walls only): every
+    /// rank then books the same. Collective.
+    ///
+    /// # Errors
+    /// The transport's.
+    pub(super) fn sum_wall_work(&self, local: WallWork) -> Result<WallWork, SolverError> {
+        let Some(on) = self
+            .on_ranks
+            .as_ref()
+            .filter(|_| !self.fixities.walls().is_empty())
+        else {
+            return Ok(local);
+        };
+        let mut sums = [local.friction, local.impact];
+        on.ranks.all_reduce(&mut sums, Reduce::Sum)?;
+        Ok(WallWork {
+            friction: sums[0],
+            impact: sums[1],
+        })
     }
 
     /// A local outcome decided over the ranks ([`ranks::agree`]).
