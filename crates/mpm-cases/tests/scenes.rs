@@ -808,6 +808,16 @@ fn malformed_scenes_are_refused_with_a_located_message() {
             "bad.toml:20:8: kind = velocity needs the explicit solver",
         ),
         (
+            "kind = \"fixed\"",
+            "kind = \"friction\"\nfriction = 0.3",
+            "bad.toml:20:8: kind = friction needs the explicit solver; the implicit solver has no friction wall (a roller is its slip wall)",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"fixed\"\nfriction = 0.3",
+            "bad.toml:21:12: `friction` applies to kind = friction, not fixed",
+        ),
+        (
             "steps = 2",
             "steps = 0",
             "bad.toml:27:9: solver `steps` must be at least 1, got 0",
@@ -1128,6 +1138,31 @@ fn malformed_scenes_are_refused_with_a_located_message() {
             "kind = \"fixed\"",
             "kind = \"fixed\"\nvelocity = { x = 1.0 }",
             "bad.toml:20:8: `velocity` applies to kind = velocity, not fixed",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"friction\"",
+            "bad.toml:20:8: kind = friction needs `friction = μ`, the Coulomb coefficient (≥ 0; 0 is a slip wall that lets go)",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"friction\"\nfriction = -0.1",
+            "bad.toml:21:12: `friction` is a Coulomb coefficient: finite and ≥ 0, got -0.1",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"velocity\"\nvelocity = { x = 1.0 }\nfriction = 0.2",
+            "bad.toml:22:12: `friction` applies to kind = friction, not velocity",
+        ),
+        (
+            "kind = \"fixed\"",
+            "kind = \"friction\"\nfriction = 0.2\ndisplacement = { y = 0.0 }",
+            "bad.toml:20:8: `displacement` applies to kind = displacement, not friction",
+        ),
+        (
+            "[[boundary]]\nset = \"y_min\"\nkind = \"fixed\"",
+            "[[node_set]]\nname = \"s\"\nregion = { box = { lower = [0.0, 0.0], upper = [2.0, 0.1] } }\n\n[[boundary]]\nset = \"s\"\nkind = \"friction\"\nfriction = 0.2",
+            "bad.toml:23:7: a friction wall needs a grid face for its normal (x_max, x_min, y_max, y_min); `s` is not one",
         ),
         (
             "kind = \"fixed\"",

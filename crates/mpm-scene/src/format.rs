@@ -460,6 +460,11 @@ pub enum BoundaryKind {
     /// The components given in `velocity` prescribed at a constant nodal
     /// velocity (explicit solver; refused by the implicit one).
     Velocity,
+    /// A rigid wall beyond a grid face with Coulomb friction coefficient
+    /// `friction`: a node moving into it loses its normal velocity and up
+    /// to `friction` times that of its tangential velocity; a node moving
+    /// away is free (explicit solver; refused by the implicit one).
+    Friction,
 }
 
 /// Per-axis values; axes not given are left alone.
@@ -511,6 +516,10 @@ pub struct BoundarySpec {
     /// given components (m/s).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub velocity: Option<Spanned<Axes>>,
+    /// For `friction` (explicit solver): the Coulomb coefficient μ ≥ 0
+    /// (dimensionless; 0 is a slip wall that lets go).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<Spanned<f64>>,
 }
 
 /// `[[point_fixity]]`: material-point fixities (explicit solver; the

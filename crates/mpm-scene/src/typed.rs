@@ -411,6 +411,7 @@ impl BoundarySpec {
             gradient: None,
             curve: None,
             velocity: None,
+            friction: None,
         }
     }
 

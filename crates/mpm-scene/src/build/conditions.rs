@@ -1,8 +1,11 @@
 //! The `[[boundary]]` conditions and the mesh motion: per mesh dof, the
 //! displacement prescribed where its curve is 1 (fixed, roller,
 //! displacement and gradient conditions), the conditions on sets that
-//! follow a body, the explicit solver's prescribed velocities, and
-//! `[mesh.motion]`. Later conditions replace earlier ones on shared dofs.
+//! follow a body, the explicit solver's prescribed velocities and friction
+//! walls, and `[mesh.motion]`. Later conditions replace earlier ones on
+//! shared dofs.
+
+use std::collections::BTreeMap;
 
 use nalgebra::{SMatrix, SVector};
 
@@ -24,6 +27,9 @@ pub(super) struct Conditions<const D: usize> {
     /// at (0 for the held nodes of fixed, roller and zero-displacement
     /// conditions).
     pub(super) velocity_dofs: Vec<Option<f64>>,
+    /// The explicit solver's friction walls: (node, axis, upper face, μ),
+    /// sorted by node and face.
+    pub(super) walls: Vec<(usize, usize, bool, f64)>,
 }
 
 /// The conditions of `scene` (its boundaries, then its mesh motion) on
@@ -45,6 +51,7 @@ pub(super) fn conditions<const D: usize>(
     let mut held = Held {
         dofs: vec![None; node_count * D],
         velocity_dofs: vec![None; node_count * D],
+        walls: BTreeMap::new(),
         following: Vec::new(),
         initial_nodes: (0..node_count)
             .map(|v| mesh.mesh.node_position(v))
@@ -76,6 +83,9 @@ pub(super) fn conditions<const D: usize>(
             motion,
         },
         velocity_dofs: held.velocity_dofs,
+        walls: (held.walls.into_iter())
+            .map(|((node, axis, upper), mu)| (node, axis, upper, mu))
+            .collect(),
     })
 }
 
@@ -85,6 +95,8 @@ struct Held<'a, const D: usize> {
     dofs: Vec<Option<(f64, u16)>>,
     /// Per mesh dof: the explicit solver's velocity.
     velocity_dofs: Vec<Option<f64>>,
+    /// Friction walls by (node, axis, upper face): μ.
+    walls: BTreeMap<(usize, usize, bool), f64>,
     /// Conditions on sets that follow a body.
     following: Vec<Following<D>>,
     /// Initial node positions.
@@ -111,6 +123,25 @@ impl<const D: usize> Held<'_, D> {
                     "`velocity` applies to kind = velocity, not {}",
                     boundary_kind_name(kind)
                 ),
+            ));
+        }
+        if let Some(mu) = spec
+            .friction
+            .as_ref()
+            .filter(|_| kind != BoundaryKind::Friction)
+        {
+            return Err(src.at(
+                mu,
+                format!(
+                    "`friction` applies to kind = friction, not {}",
+                    boundary_kind_name(kind)
+                ),
+            ));
+        }
+        if kind == BoundaryKind::Friction && !self.explicit {
+            return Err(src.at(
+                &spec.kind,
+                "kind = friction needs the explicit solver; the implicit solver has no friction wall (a roller is its slip wall)",
             ));
         }
         if self.explicit && self.sets.following.contains_key(spec.set.get_ref()) {
@@ -143,6 +174,7 @@ impl<const D: usize> Held<'_, D> {
                 &spec.kind,
                 "kind = velocity needs the explicit solver; the implicit solver prescribes displacements (kind = displacement)",
             )),
+            BoundaryKind::Friction => self.friction(spec, nodes),
         }
     }
 
@@ -187,11 +219,12 @@ impl<const D: usize> Held<'_, D> {
                     self.curves.index(&spec.curve, src)?,
                 )
             }
-            BoundaryKind::Roller => {
+            BoundaryKind::Roller | BoundaryKind::Friction => {
                 return Err(src.at(
                     &spec.set,
                     format!(
-                        "a roller needs a grid face for its normal; `{}` follows a body",
+                        "{} needs a grid face for its normal; `{}` follows a body",
+                        wall_name(*spec.kind.get_ref()),
                         spec.set.get_ref()
                     ),
                 ));
@@ -218,43 +251,60 @@ impl<const D: usize> Held<'_, D> {
     /// `kind = "fixed"` (every component) or `"roller"` (the normal of a
     /// face).
     fn hold(&mut self, spec: &BoundarySpec, nodes: &[usize]) -> Result<(), SceneError> {
-        let src = self.src;
-        let not_here = |what: &str, kind: &str| {
-            src.at(
-                &spec.kind,
-                format!("`{what}` applies to kind = displacement, not {kind}"),
-            )
-        };
-        let kind = if *spec.kind.get_ref() == BoundaryKind::Fixed {
-            "fixed"
-        } else {
-            "roller"
-        };
-        if spec.displacement.is_some() {
-            return Err(not_here("displacement", kind));
-        }
-        if spec.curve.is_some() {
-            return Err(not_here("curve", kind));
-        }
-        if spec.gradient.is_some() {
-            return Err(not_here("gradient", kind));
-        }
+        self.no_displacement_keys(spec)?;
         if *spec.kind.get_ref() == BoundaryKind::Fixed {
             (0..D).for_each(|i| self.prescribe(nodes, i, 0.0, 0));
         } else {
-            let axis = (0..D)
-                .find(|&i| [face_name(i, false), face_name(i, true)].contains(spec.set.get_ref()));
-            let Some(axis) = axis else {
-                return Err(src.at(
-                    &spec.set,
-                    format!(
-                        "a roller needs a grid face for its normal ({}); `{}` is not one",
-                        self.sets.faces.join(", "),
-                        spec.set.get_ref()
-                    ),
-                ));
-            };
+            let (axis, _) = self.face_of(spec)?;
             self.prescribe(nodes, axis, 0.0, 0);
+        }
+        Ok(())
+    }
+
+    /// The axis and side (upper) of the grid face `spec.set`, which a
+    /// roller or friction wall needs for its normal.
+    fn face_of(&self, spec: &BoundarySpec) -> Result<(usize, bool), SceneError> {
+        let set = spec.set.get_ref();
+        let face = (0..D)
+            .flat_map(|i| [(i, false), (i, true)])
+            .find(|&(i, upper)| face_name(i, upper) == *set);
+        face.ok_or_else(|| {
+            self.src.at(
+                &spec.set,
+                format!(
+                    "{} needs a grid face for its normal ({}); `{set}` is not one",
+                    wall_name(*spec.kind.get_ref()),
+                    self.sets.faces.join(", "),
+                ),
+            )
+        })
+    }
+
+    /// `kind = "friction"` (explicit solver): the face's nodes become nodes
+    /// of a friction wall with coefficient `friction`; the wall replaces an
+    /// earlier hold of their normal component (a later one replaces the
+    /// wall: the solver holds a node whose normal is held).
+    fn friction(&mut self, spec: &BoundarySpec, nodes: &[usize]) -> Result<(), SceneError> {
+        let src = self.src;
+        self.no_displacement_keys(spec)?;
+        let Some(mu) = &spec.friction else {
+            return Err(src.at(
+                &spec.kind,
+                "kind = friction needs `friction = μ`, the Coulomb coefficient (≥ 0; 0 is a slip wall that lets go)",
+            ));
+        };
+        let value = *mu.get_ref();
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(src.at(
+                mu,
+                format!("`friction` is a Coulomb coefficient: finite and ≥ 0, got {value}"),
+            ));
+        }
+        let (axis, upper) = self.face_of(spec)?;
+        for &v in nodes {
+            self.walls.insert((v, axis, upper), value);
+            self.dofs[v * D + axis] = None;
+            self.velocity_dofs[v * D + axis] = None;
         }
         Ok(())
     }
@@ -308,22 +358,32 @@ impl<const D: usize> Held<'_, D> {
         Ok(())
     }
 
+    /// Refuses `displacement`, `curve` and `gradient` on a condition of
+    /// another kind than `displacement`.
+    fn no_displacement_keys(&self, spec: &BoundarySpec) -> Result<(), SceneError> {
+        for (key, present) in [
+            ("displacement", spec.displacement.is_some()),
+            ("curve", spec.curve.is_some()),
+            ("gradient", spec.gradient.is_some()),
+        ] {
+            if present {
+                return Err(self.src.at(
+                    &spec.kind,
+                    format!(
+                        "`{key}` applies to kind = displacement, not {}",
+                        boundary_kind_name(*spec.kind.get_ref())
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// `kind = "velocity"` (explicit solver): the given components move at
     /// a constant velocity.
     fn velocity(&mut self, spec: &BoundarySpec, nodes: &[usize]) -> Result<(), SceneError> {
         let src = self.src;
-        for (key, present) in [
-            ("displacement", spec.displacement.is_some()),
-            ("gradient", spec.gradient.is_some()),
-            ("curve", spec.curve.is_some()),
-        ] {
-            if present {
-                return Err(src.at(
-                    &spec.kind,
-                    format!("`{key}` applies to kind = displacement, not velocity"),
-                ));
-            }
-        }
+        self.no_displacement_keys(spec)?;
         let Some(v) = &spec.velocity else {
             return Err(src.at(
                 &spec.kind,
@@ -358,6 +418,16 @@ fn boundary_kind_name(kind: BoundaryKind) -> &'static str {
         BoundaryKind::Roller => "roller",
         BoundaryKind::Displacement => "displacement",
         BoundaryKind::Velocity => "velocity",
+        BoundaryKind::Friction => "friction",
+    }
+}
+
+/// What a condition on a face is called in messages: "a roller", "a
+/// friction wall".
+fn wall_name(kind: BoundaryKind) -> &'static str {
+    match kind {
+        BoundaryKind::Friction => "a friction wall",
+        _ => "a roller",
     }
 }
 
@@ -377,4 +447,81 @@ fn gradient_of<const D: usize>(
         return Err(src.at(g, "`gradient` must be finite"));
     }
     Ok(SMatrix::<f64, D, D>::from_fn(|i, j| rows[i][j]))
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::Problem;
+
+    /// A block on the floor of a 2 x 2 grid, explicit, with `boundaries`.
+    fn build(boundaries: &str) -> Problem<2> {
+        let text = format!(
+            r#"[mesh]
+origin = [0.0, 0.0]
+size = [1.0, 1.0]
+cells = [2, 2]
+
+[[material]]
+name = "m"
+model = "neo_hookean"
+youngs_modulus = 1.0e6
+poisson_ratio = 0.3
+density = 1.0
+
+[[body]]
+name = "b"
+material = "m"
+region = {{ box = {{ lower = [0.0, 0.0], upper = [1.0, 0.5] }} }}
+
+{boundaries}
+[solver]
+kind = "explicit"
+basis = "bspline2_boundary"
+end_time = 0.1
+"#
+        );
+        let (scene, src) = crate::parse(&text, "s.toml", &[]).expect("the scene parses");
+        Problem::<2>::build(&scene, &src, scene.solver.padding()).expect("the scene builds")
+    }
+
+    /// A wall's (node, axis, upper, μ).
+    type Wall = (usize, usize, bool, f64);
+
+    /// The walls the solver keeps, and the held (node, component)s.
+    fn conditions(boundaries: &str) -> (Vec<Wall>, Vec<(usize, usize)>) {
+        let problem = build(boundaries);
+        let mut fixities = problem.explicit.expect("an explicit scene").fixities;
+        fixities.finish();
+        (
+            (fixities.walls().iter())
+                .map(|w| (w.node, w.axis, w.upper, w.mu))
+                .collect(),
+            fixities.entries().iter().map(|&(n, c, _)| (n, c)).collect(),
+        )
+    }
+
+    /// In file order, a friction wall replaces a roller on the same face
+    /// and a roller (or any hold of the normal) a friction wall; a later
+    /// wall on a face replaces the earlier; the x_max face's walls push
+    /// along +x.
+    #[test]
+    fn friction_walls_and_holds_replace_each_other_in_file_order() {
+        let roller = "[[boundary]]\nset = \"y_min\"\nkind = \"roller\"\n";
+        let wall = |face: &str, mu: f64| {
+            format!("[[boundary]]\nset = \"{face}\"\nkind = \"friction\"\nfriction = {mu:?}\n")
+        };
+        let floor: Vec<_> = (0..3).map(|i| (i, 1, false, 0.3)).collect();
+        let (walls, held) = conditions(&format!("{roller}{}", wall("y_min", 0.3)));
+        assert_eq!((walls, held), (floor.clone(), vec![]));
+        let (walls, held) = conditions(&format!("{}{roller}", wall("y_min", 0.3)));
+        assert_eq!(walls, vec![]);
+        assert_eq!(held, (0..3).map(|i| (i, 1)).collect::<Vec<_>>());
+        let (walls, _) = conditions(&format!("{}{}", wall("y_min", 0.1), wall("y_min", 0.3)));
+        assert_eq!(walls, floor);
+        let (walls, _) = conditions(&wall("x_max", 0.0));
+        assert_eq!(
+            walls,
+            vec![(2, 0, true, 0.0), (5, 0, true, 0.0), (8, 0, true, 0.0)]
+        );
+    }
 }

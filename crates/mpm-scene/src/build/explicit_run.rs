@@ -152,10 +152,12 @@ fn point_fixities<const D: usize>(
 
 impl<const D: usize> ExplicitRun<D> {
     /// The run's setup with the nodal velocities `velocity_dofs` (per mesh
-    /// dof) and the loads `loads`.
+    /// dof), the friction walls `walls` ((node, axis, upper face, μ)) and
+    /// the loads `loads`.
     pub(super) fn setup(
         self,
         velocity_dofs: &[Option<f64>],
+        walls: &[(usize, usize, bool, f64)],
         loads: ExplicitLoads<D>,
     ) -> ExplicitSetup<D> {
         let k = self.keys;
@@ -172,6 +174,9 @@ impl<const D: usize> ExplicitRun<D> {
         let mut fixities = mpm_solver::VelocityFixities::new();
         for ((component, bits), nodes) in groups {
             fixities.prescribe(nodes, component, f64::from_bits(bits));
+        }
+        for &(node, axis, upper, mu) in walls {
+            fixities.friction([node], axis, upper, mu);
         }
         ExplicitSetup {
             end_time: k.end_time,

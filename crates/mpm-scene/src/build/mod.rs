@@ -309,7 +309,8 @@ pub struct ExplicitSetup<const D: usize> {
     /// loads).
     pub gravity: SVector<f64, D>,
     /// Zero-velocity fixities of the fixed, roller and zero-displacement
-    /// conditions, and the constant velocities of `velocity` conditions.
+    /// conditions, the constant velocities of `velocity` conditions and
+    /// the friction walls of `friction` conditions.
     pub fixities: mpm_solver::VelocityFixities,
     /// Initial velocity of every point.
     pub velocity: Vec<SVector<f64, D>>,
@@ -662,7 +663,7 @@ impl<const D: usize> Problem<D> {
             strength_reduction::strength_reduction(scene, &probes, explicit, src)?;
         let explicit =
             explicit_run::explicit_run(explicit_keys, scene, &mesh, &materials, &bodies, src)?
-                .map(|run| run.setup(&conditions.velocity_dofs, loads.explicit));
+                .map(|run| run.setup(&conditions.velocity_dofs, &conditions.walls, loads.explicit));
 
         let points = bodies.points;
         Ok(Self {
