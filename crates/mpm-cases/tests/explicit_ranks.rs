@@ -436,3 +436,41 @@ fn matches_one_process_on_ranks(problem: &Problem<2>, label: &str) -> Seen {
     }
     single
 }
+
+/// A friction wall on ranks (issue 44): the sliding block
+/// (`scenes/sliding_block.toml`, μ = 0.1, to t = 0.02 s) on 2 and 3 ranks
+/// books the friction and impact work of one process — every rank that
+/// touches a floor node applies the wall, its owner alone counts the
+/// work — within issue 42's energy bound, and its points move as one
+/// process's.
+#[test]
+fn friction_walls_on_ranks_book_their_work_once() {
+    let short = ["solver.end_time=0.02".to_owned()];
+    let text = include_str!("../../../scenes/sliding_block.toml");
+    let (scene, source) = scene::parse(text, "sliding_block.toml", &short).unwrap();
+    let problem = Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap();
+    let one = run_with(&problem, &RunControl::default());
+    let last = one.energies.last().unwrap();
+    assert!(last.friction_work > 0.0 && last.wall_work > 0.0, "{last:?}");
+    for size in [2, 3] {
+        let ranks = on_ranks(&problem, size);
+        assert_eq!(ranks.steps, one.steps, "{size} ranks");
+        for (a, b) in one.energies.iter().zip(&ranks.energies) {
+            for (x, y) in [
+                (a.friction_work, b.friction_work),
+                (a.wall_work, b.wall_work),
+            ] {
+                assert!(
+                    (x - y).abs() <= 1e-10 * x.abs().max(f64::MIN_POSITIVE),
+                    "{size} ranks: {a:?} against {b:?}"
+                );
+            }
+        }
+        assert!(energy_difference(&one.energies, &ranks.energies) <= 1e-10);
+        let (dx, _) = differences(&one.snapshots, &ranks.snapshots);
+        assert!(
+            dx <= 1e-10 * 0.005,
+            "{size} ranks: positions differ by {dx:e} m"
+        );
+    }
+}
