@@ -131,7 +131,8 @@ pub struct ExplicitSummary<P: Serialize> {
     /// Wall time per stage of this session (`p2g`, `grid`, `g2p`), seconds.
     pub stage_times_s: serde_json::Value,
     /// Energies at t = 0 (`kinetic`, `strain`, `gravitational`,
-    /// `external_work`, `friction_work`, `wall_work`, `total`).
+    /// `external_work`, `friction_work`, `wall_work`, `absorbed_work`,
+    /// `total`).
     pub initial_energies: serde_json::Value,
     /// Energies at the end.
     pub final_energies: serde_json::Value,

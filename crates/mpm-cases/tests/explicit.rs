@@ -449,7 +449,7 @@ fn summary(dir: &Path) -> serde_json::Value {
 /// taken in another order), and every explicit output.
 #[test]
 fn one_and_two_threads_give_the_same_energies() {
-    let header = "time,kinetic,strain,gravitational,external_work,friction_work,wall_work,total";
+    let header = "time,kinetic,strain,gravitational,external_work,friction_work,wall_work,absorbed_work,total";
     let mut runs = Vec::new();
     for threads in ["1", "2"] {
         let dir = common::fresh_dir(&format!("explicit-threads-{threads}"));
@@ -473,9 +473,9 @@ fn one_and_two_threads_give_the_same_energies() {
         assert_eq!(rows[0][0], 0.0);
         assert!((rows[12][0] - 30.0).abs() < 1e-9);
         for row in &rows {
-            assert_eq!((row[5], row[6]), (0.0, 0.0), "no friction wall");
-            let total = row[1] + row[2] + row[3] + row[5] + row[6] - row[4];
-            assert!((row[7] - total).abs() < 1e-15, "{row:?}");
+            assert_eq!((row[5], row[6], row[7]), (0.0, 0.0, 0.0), "no wall");
+            let total = row[1] + row[2] + row[3] + row[5] + row[6] + row[7] - row[4];
+            assert!((row[8] - total).abs() < 1e-15, "{row:?}");
         }
         let probe = csv_rows(&dir.join("probe_tip.csv"), "time,ux,uy");
         assert_eq!(probe.len(), 13);
@@ -503,11 +503,11 @@ fn one_and_two_threads_give_the_same_energies() {
         assert!(s["wall_time_s"].as_f64().unwrap() > 0.0);
         let drift = s["energy_drift"].as_f64().unwrap();
         assert!(drift < 0.0 && drift > -0.03, "{drift}");
-        assert_eq!(s["final_energies"]["total"].as_f64().unwrap(), rows[12][7]);
+        assert_eq!(s["final_energies"]["total"].as_f64().unwrap(), rows[12][8]);
         runs.push(rows);
     }
     for (a, b) in runs[0].iter().zip(&runs[1]) {
-        let scale = a[7].abs();
+        let scale = a[8].abs();
         for (x, y) in a.iter().zip(b) {
             assert!((x - y).abs() <= 1e-9 * scale, "{a:?} against {b:?}");
         }
@@ -785,7 +785,7 @@ fn a_soft_and_a_stiff_disk_run_as_a_material_set_and_resume() {
         .skip(1)
         .map(|l| {
             let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            (v[0], v[7])
+            (v[0], v[8])
         })
         .collect();
     let initial = totals[0].1;

@@ -272,9 +272,9 @@ fn petsc_over_2_processes_takes_the_direct_solvers_steps() {
 
 /// The explicit column on 2 processes: the same outputs, the energies
 /// (`energy.csv`: time, kinetic, strain, gravitational, external work,
-/// friction and wall work, total) within 1e-10 of the largest (issue 42; the thread ranks of
-/// `tests/explicit_ranks.rs` measure 1e-15); stopped and resumed, the
-/// same files byte for byte.
+/// friction, wall and absorbed work, total) within 1e-10 of the largest
+/// (issue 42; the thread ranks of `tests/explicit_ranks.rs` measure
+/// 1e-15); stopped and resumed, the same files byte for byte.
 #[test]
 fn an_explicit_scene_on_2_processes_writes_what_one_process_writes() {
     let root = std::env::temp_dir().join(format!("mpm-mpi-explicit-{}", std::process::id()));

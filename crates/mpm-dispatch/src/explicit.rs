@@ -792,6 +792,7 @@ impl<const D: usize> Outputs<'_, '_, D> {
         clock.wall_work = WallWork {
             friction: at.energies.friction_work,
             impact: at.energies.wall_work,
+            absorbed: at.energies.absorbed_work,
         };
         clock.scale = clock.scale.max(at.energies.kinetic + at.energies.strain);
         self.frame(run, at, clock, wall)
@@ -969,8 +970,8 @@ impl Wall {
 
 /// What an explicit checkpoint keeps besides the points and the step
 /// count: the output reached, the work of the applied forces, what the
-/// friction walls took, the initial energies and the energy scale (in
-/// [`Checkpoint::case_state`]).
+/// friction walls and absorbing boundaries took, the initial energies and
+/// the energy scale (in [`Checkpoint::case_state`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Clock {
     index: usize,
@@ -981,7 +982,7 @@ pub(crate) struct Clock {
 }
 
 impl Clock {
-    pub(crate) const LEN: usize = 9;
+    pub(crate) const LEN: usize = 10;
 
     fn to_case_state(self) -> Vec<f64> {
         let e = self.initial;
@@ -995,6 +996,7 @@ impl Clock {
             self.scale,
             self.wall_work.friction,
             self.wall_work.impact,
+            self.wall_work.absorbed,
         ]
     }
 
@@ -1021,6 +1023,7 @@ impl Clock {
             wall_work: WallWork {
                 friction: s[7],
                 impact: s[8],
+                absorbed: s[9],
             },
         })
     }

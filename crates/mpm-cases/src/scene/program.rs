@@ -412,6 +412,7 @@ fn energies_json(e: &mpm_solver::explicit::Energies) -> Value {
         "external_work": e.external_work,
         "friction_work": e.friction_work,
         "wall_work": e.wall_work,
+        "absorbed_work": e.absorbed_work,
         "total": e.total(),
     })
 }
@@ -448,7 +449,7 @@ where
     let mut rebalances = Vec::new();
     obs.show_time();
     obs.writer.set_vtu_options(vtu_options(problem, true));
-    const ENERGY_HEADER: [&str; 8] = [
+    const ENERGY_HEADER: [&str; 9] = [
         "time",
         "kinetic",
         "strain",
@@ -456,6 +457,7 @@ where
         "external_work",
         "friction_work",
         "wall_work",
+        "absorbed_work",
         "total",
     ];
     let axes = ["x", "y", "z"];
@@ -488,6 +490,7 @@ where
                 e.external_work,
                 e.friction_work,
                 e.wall_work,
+                e.absorbed_work,
                 e.total(),
             ]
             .map(CsvValue::from);

@@ -23,21 +23,32 @@ pub struct Energies {
     /// Energy lost in impacts on the friction walls since the start
     /// ([`super::WallWork::impact`]).
     pub wall_work: f64,
+    /// Energy absorbed by the absorbing boundaries since the start
+    /// ([`super::WallWork::absorbed`]).
+    pub absorbed_work: f64,
 }
 
 impl Energies {
-    /// Kinetic + strain + gravitational + what the friction walls took −
-    /// external work: constant for a conservative scheme.
+    /// Kinetic + strain + gravitational + what the friction walls and
+    /// the absorbing boundaries took − external work: constant for a
+    /// conservative scheme.
     pub fn total(&self) -> f64 {
-        self.kinetic + self.strain + self.gravitational + self.friction_work + self.wall_work
+        self.kinetic
+            + self.strain
+            + self.gravitational
+            + self.friction_work
+            + self.wall_work
+            + self.absorbed_work
             - self.external_work
     }
 
-    /// The same energies with what the friction walls took so far.
+    /// The same energies with what the friction walls and the absorbing
+    /// boundaries took so far.
     pub fn with_wall_work(self, work: super::WallWork) -> Self {
         Self {
             friction_work: work.friction,
             wall_work: work.impact,
+            absorbed_work: work.absorbed,
             ..self
         }
     }

@@ -1,5 +1,8 @@
 //! Prescribed nodal velocities (MPoint notes, below eq. 32) and Coulomb
-//! friction walls on grid faces (Bardenhagen, Brackbill & Sulsky 2000).
+//! friction walls on grid faces (Bardenhagen, Brackbill & Sulsky 2000)
+//! and the dashpots of absorbing boundaries (Lysmer & Kuhlemeyer 1969).
+
+use super::absorbing::Dashpot;
 
 /// Nodal velocity fixities: after the grid update (eq. 32) the listed
 /// components are set, $\tilde v_i^{n+1} = v^{fix}_i$, and their
@@ -23,6 +26,10 @@ pub struct VelocityFixities {
     /// [`VelocityFixities::finish`] sorts them by node and face, drops
     /// repeats (the later kept) and those whose normal component is held.
     walls: Vec<FrictionWall>,
+    /// The absorbing boundaries' dashpots, in the order given until
+    /// [`VelocityFixities::finish`] sorts them by node and face, drops
+    /// repeats (the later kept) and those whose every component is held.
+    dashpots: Vec<Dashpot>,
 }
 
 /// One node of a rigid, fixed wall with Coulomb friction: the wall lies
@@ -101,6 +108,28 @@ impl VelocityFixities {
         self
     }
 
+    /// Makes the `(node, tributary area)` pairs of `nodes` nodes of an
+    /// absorbing boundary on the grid face normal to `axis`, in a medium
+    /// of normal impedance `rho_cp` $=\rho c_p$ and tangential impedance
+    /// `rho_cs` $=\rho c_s$ (Pa·s/m; [`Dashpot`],
+    /// [`super::absorbing::tributary_area`]); a later boundary on the same
+    /// node and face replaces the earlier. Its dashpots act on the
+    /// components no fixity holds.
+    pub fn absorbing(
+        &mut self,
+        nodes: impl IntoIterator<Item = (usize, f64)>,
+        axis: usize,
+        rho_cp: f64,
+        rho_cs: f64,
+    ) -> &mut Self {
+        self.dashpots.extend(
+            nodes
+                .into_iter()
+                .map(|(node, area)| Dashpot::new(node, axis, area, rho_cp, rho_cs)),
+        );
+        self
+    }
+
     /// Sorts the fixities by node and component, a later value of a
     /// repeated component replacing the earlier one, and the walls by
     /// node and face alike (the solver calls it once when it takes the
@@ -128,6 +157,27 @@ impl VelocityFixities {
             }
         }
         self.finish_walls();
+        self.finish_dashpots();
+    }
+
+    /// The dashpots sorted by node and face, the later of a repeated one
+    /// kept, each one's free components marked and those with none
+    /// dropped.
+    fn finish_dashpots(&mut self) {
+        self.dashpots.sort_by_key(|d| (d.node, d.axis));
+        let mut out: Vec<Dashpot> = Vec::with_capacity(self.dashpots.len());
+        for d in self.dashpots.drain(..) {
+            match out.last_mut() {
+                Some(last) if (last.node, last.axis) == (d.node, d.axis) => *last = d,
+                _ => out.push(d),
+            }
+        }
+        for d in &mut out {
+            d.free = (0..8)
+                .filter(|&c| self.held(d.node, c).is_none())
+                .fold(0, |bits, c| bits | 1 << c);
+        }
+        self.dashpots = out;
     }
 
     /// The walls sorted by node and face, the later of a repeated one
@@ -180,12 +230,18 @@ impl VelocityFixities {
         &self.walls
     }
 
+    /// The absorbing boundaries' dashpots: sorted by node and face after
+    /// [`VelocityFixities::finish`], in the order given before.
+    pub fn dashpots(&self) -> &[Dashpot] {
+        &self.dashpots
+    }
+
     /// Number of fixed components.
     pub fn len(&self) -> usize {
         self.entries.len()
     }
 
-    /// Whether nothing is fixed (friction walls aside).
+    /// Whether nothing is fixed (friction walls and dashpots aside).
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }

@@ -1,9 +1,10 @@
 //! Stage 2, the grid update: nodal velocity (eq. 30), acceleration (eq.
-//! 31), updated velocity (eq. 32), the velocity fixities and the friction
-//! walls.
+//! 31), updated velocity (eq. 32), the velocity fixities, the friction
+//! walls and the absorbing boundaries.
 
 use rayon::prelude::*;
 
+use super::absorbing;
 use super::fixities::{FrictionWall, VelocityFixities};
 use super::grid::{GridBuffer, NodeSums};
 pub use super::grid::{GridState, NodeVelocity};
@@ -11,8 +12,8 @@ pub use super::grid::{GridState, NodeVelocity};
 /// Nodes per parallel task of the grid update.
 const NODES_PER_TASK: usize = 4096;
 
-/// The energy the friction walls took from the grid (J; per unit
-/// thickness in 2D), both parts positive.
+/// The energy the friction walls and the absorbing boundaries took from
+/// the grid (J; per unit thickness in 2D), every part positive.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct WallWork {
     /// Dissipated by friction: per sliding node the friction impulse
@@ -23,14 +24,19 @@ pub struct WallWork {
     /// the normal velocity it brought to the step,
     /// $\tfrac12 m_i(\mathbf v^n_i\cdot\mathbf n)^2$.
     pub impact: f64,
+    /// Absorbed by the dashpots of the absorbing boundaries: per node
+    /// and free component the dashpot's impulse times the velocity it
+    /// leaves, $\Delta t\,C_c\,{v'_c}^2$ ([`absorbing::dashpots`]).
+    pub absorbed: f64,
 }
 
 impl WallWork {
-    /// Both parts added.
+    /// Every part added.
     pub fn plus(self, other: Self) -> Self {
         Self {
             friction: self.friction + other.friction,
             impact: self.impact + other.impact,
+            absorbed: self.absorbed + other.absorbed,
         }
     }
 }
@@ -40,8 +46,10 @@ impl WallWork {
 /// $\tilde v^{n+1}_i$ is set to the prescribed value, which recomputes the
 /// acceleration as the notes require (a fixity on a node without mass has
 /// no effect: no point reads it); then the friction walls
-/// ([`friction_walls`]). Returns what the walls took from the nodes for
-/// which `counted` is true (on several ranks, those the rank owns).
+/// ([`friction_walls`]) and the absorbing boundaries
+/// ([`absorbing::dashpots`]). Returns what the walls and dashpots took
+/// from the nodes for which `counted` is true (on several ranks, those the
+/// rank owns).
 pub fn update<const D: usize>(
     buffers: &[GridBuffer<D>],
     grid: &mut GridState<D>,
@@ -95,7 +103,11 @@ pub fn update<const D: usize>(
             grid.velocity[node].new[component] = value;
         }
     }
-    friction_walls(grid, fixities.walls(), counted)
+    let walls = friction_walls(grid, fixities.walls(), &counted);
+    WallWork {
+        absorbed: absorbing::dashpots(grid, fixities.dashpots(), dt, &counted),
+        ..walls
+    }
 }
 
 /// Coulomb friction against rigid, fixed walls at the nodes of `walls`

@@ -11,7 +11,7 @@
 //! 2. [`p2g::scatter`]: mass, momentum (Taylor term, eq. 29), forces
 //!    (eqs. 20–22), in parallel into per-thread [`p2g::GridBuffer`]s;
 //! 3. [`grid_update::update`]: the sum of the buffers, velocities (eqs.
-//!    30–32), fixities and friction walls;
+//!    30–32), fixities, friction walls and absorbing boundaries;
 //! 4. [`g2p`]: velocity (eq. 36), position (eq. 37 corrected), velocity
 //!    gradient (eq. 38), optionally the cell-averaged dilatation (eqs.
 //!    47–53, [`CellAveraged`]), deformation gradient, volume (eqs. 39–41)
@@ -28,6 +28,7 @@
 //! in spatial order (as the scene generators number them) touch disjoint
 //! parts of the grid, so the buffers cost little more than one grid.
 
+pub mod absorbing;
 pub mod dilatation;
 pub mod energy;
 pub mod fixities;
@@ -49,6 +50,7 @@ use mpm_basis::BasisFunction;
 use mpm_constitutive::IncrementalLaw;
 use nalgebra::{SMatrix, SVector};
 
+pub use absorbing::Dashpot;
 pub use dilatation::{CellAveraged, DilatationTreatment};
 pub use energy::Energies;
 pub use fixities::{FrictionWall, VelocityFixities};
@@ -205,7 +207,8 @@ where
     time: f64,
     steps: usize,
     external_work: f64,
-    /// What the friction walls took so far (over every rank).
+    /// What the friction walls and absorbing boundaries took so far (over
+    /// every rank).
     wall_work: WallWork,
     stage_times: ExplicitStageTimes,
     fixed_start: Vec<f64>,
@@ -232,7 +235,8 @@ where
     /// # Errors
     /// Invalid options; a fixity on a node or component that does not
     /// exist; a friction wall on a node or axis that does not exist or
-    /// with a coefficient that is negative or not finite.
+    /// with a coefficient that is negative or not finite; a dashpot
+    /// likewise.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         basis: B,
@@ -270,6 +274,16 @@ where
             return Err(SolverError::InvalidInput(format!(
                 "friction wall at node {} normal to axis {} with μ = {}: the mesh has {node_count} nodes of {D} axes and μ must be finite and non-negative",
                 w.node, w.axis, w.mu
+            )));
+        }
+        if let Some(d) = fixities
+            .dashpots()
+            .iter()
+            .find(|d| d.node >= node_count || d.axis >= D || !d.is_valid())
+        {
+            return Err(SolverError::InvalidInput(format!(
+                "absorbing boundary at node {} normal to axis {} with dashpots C_n = {}, C_t = {}: the mesh has {node_count} nodes of {D} axes and the dashpots must be finite and non-negative",
+                d.node, d.axis, d.normal, d.tangential
             )));
         }
         let node_position = if T::TAYLOR {
@@ -416,14 +430,15 @@ where
         self.max_signal = None;
     }
 
-    /// What the friction walls took so far: the energy friction
-    /// dissipated and the energy lost in impacts on them (summed over the
-    /// ranks, the same on each).
+    /// What the friction walls and absorbing boundaries took so far: the
+    /// energy friction dissipated, the energy lost in impacts on the walls
+    /// and the energy the dashpots absorbed (summed over the ranks, the
+    /// same on each).
     pub fn wall_work(&self) -> WallWork {
         self.wall_work
     }
 
-    /// Sets what the friction walls took so far (a resumed run, as
+    /// Sets what the friction walls and dashpots took so far (a resumed run, as
     /// [`Self::wall_work`] returned it when the checkpoint was written).
     pub fn resume_wall_work(&mut self, work: WallWork) {
         self.wall_work = work;
@@ -573,7 +588,7 @@ where
     }
 
     /// The grid update (eq. 32) and the fixed points' velocities held on
-    /// the grid; returns what the friction walls took at the nodes this
+    /// the grid; returns what the friction walls and dashpots took at the nodes this
     /// rank owns.
     fn update_grid(
         &mut self,
@@ -623,7 +638,7 @@ where
 
     /// Kinetic, stored and gravitational energy of the points, the work
     /// of the applied point forces so far and what the friction walls
-    /// took.
+    /// and absorbing boundaries took.
     ///
     /// # Errors
     /// A law without a stored energy.

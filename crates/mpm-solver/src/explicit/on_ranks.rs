@@ -186,8 +186,8 @@ where
     }
 
     /// The step's [`WallWork`] of this rank's own nodes summed over the
-    /// ranks (one reduction, in runs with friction walls only): every
-    /// rank then books the same. Collective.
+    /// ranks (one reduction, in runs with friction walls or absorbing
+    /// boundaries only): every rank then books the same. Collective.
     ///
     /// # Errors
     /// The transport's.
@@ -195,15 +195,17 @@ where
         let Some(on) = self
             .on_ranks
             .as_ref()
-            .filter(|_| !self.fixities.walls().is_empty())
+            .filter(|_| !(self.fixities.walls().is_empty() && self.fixities.dashpots().is_empty()))
         else {
             return Ok(local);
         };
-        let mut sums = [local.friction, local.impact];
+        let mut sums = [local.friction, local.impact, local.absorbed];
         on.ranks.all_reduce(&mut sums, Reduce::Sum)?;
+        let [friction, impact, absorbed] = sums;
         Ok(WallWork {
-            friction: sums[0],
-            impact: sums[1],
+            friction,
+            impact,
+            absorbed,
         })
     }
 

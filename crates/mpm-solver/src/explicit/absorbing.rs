@@ -1,0 +1,181 @@
+//! Absorbing boundaries on grid faces: the viscous boundary of Lysmer &
+//! Kuhlemeyer (1969), one normal and one tangential dashpot per node,
+//! applied semi-implicitly after the friction walls.
+
+use mpm_mesh::RegularGrid;
+
+use super::grid::GridState;
+
+/// One node of a viscous (absorbing) boundary on the grid face normal to
+/// `axis`: the dashpots $C_n = \rho c_p A_i$ on the normal component and
+/// $C_t = \rho c_s A_i$ on each tangential one (N·s/m; per unit
+/// thickness in 2D), $A_i$ the node's tributary area on the face
+/// ([`tributary_area`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dashpot {
+    /// The node.
+    pub node: usize,
+    /// The axis normal to the face.
+    pub axis: usize,
+    /// $C_n = \rho c_p A_i$, the normal dashpot.
+    pub normal: f64,
+    /// $C_t = \rho c_s A_i$, each tangential dashpot.
+    pub tangential: f64,
+    /// Bit `c`: component `c` is not held, so its dashpot acts (set by
+    /// [`super::VelocityFixities::finish`]).
+    pub(super) free: u8,
+}
+
+impl Dashpot {
+    /// A dashpot on `node` of the face normal to `axis` whose tributary
+    /// area is `area`, for a medium of normal impedance $\rho c_p$ and
+    /// tangential impedance $\rho c_s$ (Pa·s/m).
+    pub fn new(node: usize, axis: usize, area: f64, rho_cp: f64, rho_cs: f64) -> Self {
+        Self {
+            node,
+            axis,
+            normal: rho_cp * area,
+            tangential: rho_cs * area,
+            free: 0,
+        }
+    }
+
+    /// Whether the dashpot acts on `component`: one that no fixity holds
+    /// (after [`super::VelocityFixities::finish`]).
+    #[inline]
+    pub fn damps(&self, component: usize) -> bool {
+        component < 8 && self.free >> component & 1 == 1
+    }
+
+    /// The dashpot of `component`: $C_n$ on the normal, $C_t$ on the others.
+    #[inline]
+    pub fn coefficient(&self, component: usize) -> f64 {
+        if component == self.axis {
+            self.normal
+        } else {
+            self.tangential
+        }
+    }
+
+    /// Whether the coefficients are finite and non-negative.
+    pub fn is_valid(&self) -> bool {
+        [self.normal, self.tangential]
+            .iter()
+            .all(|c| c.is_finite() && *c >= 0.0)
+    }
+}
+
+/// The tributary area of `node` on the face of `grid` normal to `axis`:
+/// the product over the in-face axes of the half-spacings on each side of
+/// the node, $h$ inside the grid and $h/2$ at its ends (2D: a length, the
+/// area per unit thickness; 1 in 1D).
+///
+/// # Panics
+/// `node` is not a node of `grid`.
+pub fn tributary_area<const D: usize>(grid: &RegularGrid<D>, node: usize, axis: usize) -> f64 {
+    let index = grid.node_index(node).expect("a node of the grid");
+    let cells = grid.cells_per_axis();
+    (0..D)
+        .filter(|&a| a != axis)
+        .map(|a| {
+            let h = grid.spacing()[a];
+            let sides = usize::from(index[a] > 0) + usize::from(index[a] < cells[a]);
+            0.5 * h * sides as f64
+        })
+        .product()
+}
+
+/// The viscous boundary (Lysmer & Kuhlemeyer 1969) at the nodes of
+/// `dashpots`, semi-implicitly: the dashpot force $-C\,v'$ is taken with
+/// the velocity it leaves, so each free component becomes
+/// $v'_c = m_i\tilde v_c/(m_i + \Delta t\,C_c)$ — unconditionally stable,
+/// however large $C$ or $\Delta t$. Nodes without mass are skipped; a node
+/// of two faces (a corner) meets both dashpots in turn. Returns the
+/// energy absorbed at the nodes for which `counted` is true, the impulse
+/// times the velocity it leaves, $\sum_c \Delta t\,C_c\,{v'_c}^2$ (the
+/// convention of the friction work, [`super::WallWork`]).
+pub fn dashpots<const D: usize>(
+    grid: &mut GridState<D>,
+    dashpots: &[Dashpot],
+    dt: f64,
+    counted: impl Fn(usize) -> bool,
+) -> f64 {
+    let mut absorbed = 0.0;
+    for d in dashpots {
+        let i = d.node;
+        if !(i >= grid.lo && i < grid.hi && grid.mass[i] > 0.0) {
+            continue;
+        }
+        let m = grid.mass[i];
+        let v = &mut grid.velocity[i].new;
+        let mut work = 0.0;
+        for c in (0..D).filter(|&c| d.damps(c)) {
+            let damping = dt * d.coefficient(c);
+            v[c] *= m / (m + damping);
+            work += damping * v[c] * v[c];
+        }
+        if counted(i) {
+            absorbed += work;
+        }
+    }
+    absorbed
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::explicit::VelocityFixities;
+    use nalgebra::{SVector, Vector2, Vector3};
+
+    /// 2D: h inside, h/2 at the ends; 3D: the product of both in-face
+    /// half-spacings on each side.
+    #[test]
+    fn tributary_areas_are_the_half_spacings_on_each_side() {
+        let g = RegularGrid::new(Vector2::zeros(), Vector2::new(0.5, 0.25), [4, 2]).unwrap();
+        let base: Vec<f64> = (0..5)
+            .map(|i| tributary_area(&g, g.node_id([i, 0]).unwrap(), 1))
+            .collect();
+        assert_eq!(base, [0.25, 0.5, 0.5, 0.5, 0.25]);
+        let side: Vec<f64> = (0..3)
+            .map(|j| tributary_area(&g, g.node_id([4, j]).unwrap(), 0))
+            .collect();
+        assert_eq!(side, [0.125, 0.25, 0.125]);
+        let g = RegularGrid::new(Vector3::zeros(), Vector3::new(1.0, 2.0, 4.0), [2, 2, 1]).unwrap();
+        let at = |i, j| tributary_area(&g, g.node_id([i, j, 0]).unwrap(), 2);
+        assert_eq!([at(0, 0), at(1, 0), at(1, 1)], [0.5, 1.0, 2.0]);
+        let total: f64 = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .map(|(i, j)| at(i, j))
+            .sum();
+        assert_eq!(total, 2.0 * 4.0);
+    }
+
+    /// The normal component meets C_n, the tangential C_t, a held
+    /// component neither; the work is Σ Δt C v'² on counted nodes only.
+    #[test]
+    fn each_free_component_is_damped_semi_implicitly() {
+        let mut grid = GridState::<2>::new(1);
+        grid.mass[0] = 2.0;
+        grid.velocity[0].new = SVector::from([1.0, -3.0]);
+        grid.hi = 1;
+        let mut f = VelocityFixities::new();
+        f.absorbing([(0, 0.5)], 1, 8.0, 4.0);
+        f.finish();
+        let dt = 0.5;
+        // C_n = 4, C_t = 2: v_y = 2·(−3)/(2 + 2), v_x = 2·1/(2 + 1).
+        let work = dashpots(&mut grid, f.dashpots(), dt, |_| true);
+        let v = grid.velocity[0].new;
+        assert!((v - Vector2::new(2.0 / 3.0, -1.5)).norm() < 1e-15, "{v}");
+        let expected = dt * (4.0 * 1.5 * 1.5 + 2.0 * (2.0 / 3.0) * (2.0 / 3.0));
+        assert!((work - expected).abs() < 1e-14);
+
+        grid.velocity[0].new = SVector::from([1.0, -3.0]);
+        let mut f = VelocityFixities::new();
+        f.absorbing([(0, 0.5)], 1, 8.0, 4.0).fix([0], 0);
+        f.finish();
+        let work = dashpots(&mut grid, f.dashpots(), dt, |_| false);
+        assert_eq!(grid.velocity[0].new, Vector2::new(1.0, -1.5));
+        assert_eq!(work, 0.0);
+    }
+}
