@@ -465,6 +465,10 @@ pub enum BoundaryKind {
     /// to `friction` times that of its tangential velocity; a node moving
     /// away is free (explicit solver; refused by the implicit one).
     Friction,
+    /// An absorbing (viscous) boundary on a grid face, with the
+    /// impedances of `material` (explicit solver; refused by the implicit
+    /// one).
+    Absorbing,
 }
 
 /// Per-axis values; axes not given are left alone.
@@ -520,6 +524,11 @@ pub struct BoundarySpec {
     /// (dimensionless; 0 is a slip wall that lets go).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<Spanned<f64>>,
+    /// For `absorbing` (explicit solver): the `[[material]]` whose
+    /// density and P- and S-wave speeds give the dashpots ρ c_p and ρ c_s
+    /// per unit area.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<Spanned<String>>,
 }
 
 /// `[[point_fixity]]`: material-point fixities (explicit solver; the

@@ -412,6 +412,7 @@ impl BoundarySpec {
             curve: None,
             velocity: None,
             friction: None,
+            material: None,
         }
     }
 

@@ -2,8 +2,8 @@
 //! displacement prescribed where its curve is 1 (fixed, roller,
 //! displacement and gradient conditions), the conditions on sets that
 //! follow a body, the explicit solver's prescribed velocities and friction
-//! walls, and `[mesh.motion]`. Later conditions replace earlier ones on
-//! shared dofs.
+//! walls, and `[mesh.motion]` (absorbing boundaries: `absorbing.rs`).
+//! Later conditions replace earlier ones on shared dofs.
 
 use std::collections::BTreeMap;
 
@@ -116,14 +116,20 @@ impl<const D: usize> Held<'_, D> {
             None => None,
         };
         let kind = *spec.kind.get_ref();
-        if spec.velocity.is_some() && kind != BoundaryKind::Velocity {
-            return Err(src.at(
-                &spec.kind,
-                format!(
-                    "`velocity` applies to kind = velocity, not {}",
-                    boundary_kind_name(kind)
-                ),
-            ));
+        for (key, present, owner) in [
+            ("velocity", spec.velocity.is_some(), BoundaryKind::Velocity),
+            ("material", spec.material.is_some(), BoundaryKind::Absorbing),
+        ] {
+            if present && kind != owner {
+                return Err(src.at(
+                    &spec.kind,
+                    format!(
+                        "`{key}` applies to kind = {}, not {}",
+                        boundary_kind_name(owner),
+                        boundary_kind_name(kind)
+                    ),
+                ));
+            }
         }
         if let Some(mu) = spec
             .friction
@@ -175,6 +181,8 @@ impl<const D: usize> Held<'_, D> {
                 "kind = velocity needs the explicit solver; the implicit solver prescribes displacements (kind = displacement)",
             )),
             BoundaryKind::Friction => self.friction(spec, nodes),
+            // Its dashpots are built by `absorbing.rs`; it holds nothing.
+            BoundaryKind::Absorbing => Ok(()),
         }
     }
 
@@ -235,6 +243,12 @@ impl<const D: usize> Held<'_, D> {
                     "kind = velocity needs the explicit solver; the implicit solver prescribes displacements (kind = displacement)",
                 ));
             }
+            BoundaryKind::Absorbing => {
+                return Err(src.at(
+                    &spec.kind,
+                    "kind = absorbing needs the explicit solver ([solver] kind = \"explicit\"); the implicit solver is static",
+                ));
+            }
         })
     }
 
@@ -251,7 +265,7 @@ impl<const D: usize> Held<'_, D> {
     /// `kind = "fixed"` (every component) or `"roller"` (the normal of a
     /// face).
     fn hold(&mut self, spec: &BoundarySpec, nodes: &[usize]) -> Result<(), SceneError> {
-        self.no_displacement_keys(spec)?;
+        refuse_displacement_keys(spec, self.src)?;
         if *spec.kind.get_ref() == BoundaryKind::Fixed {
             (0..D).for_each(|i| self.prescribe(nodes, i, 0.0, 0));
         } else {
@@ -286,7 +300,7 @@ impl<const D: usize> Held<'_, D> {
     /// wall: the solver holds a node whose normal is held).
     fn friction(&mut self, spec: &BoundarySpec, nodes: &[usize]) -> Result<(), SceneError> {
         let src = self.src;
-        self.no_displacement_keys(spec)?;
+        refuse_displacement_keys(spec, self.src)?;
         let Some(mu) = &spec.friction else {
             return Err(src.at(
                 &spec.kind,
@@ -358,32 +372,11 @@ impl<const D: usize> Held<'_, D> {
         Ok(())
     }
 
-    /// Refuses `displacement`, `curve` and `gradient` on a condition of
-    /// another kind than `displacement`.
-    fn no_displacement_keys(&self, spec: &BoundarySpec) -> Result<(), SceneError> {
-        for (key, present) in [
-            ("displacement", spec.displacement.is_some()),
-            ("curve", spec.curve.is_some()),
-            ("gradient", spec.gradient.is_some()),
-        ] {
-            if present {
-                return Err(self.src.at(
-                    &spec.kind,
-                    format!(
-                        "`{key}` applies to kind = displacement, not {}",
-                        boundary_kind_name(*spec.kind.get_ref())
-                    ),
-                ));
-            }
-        }
-        Ok(())
-    }
-
     /// `kind = "velocity"` (explicit solver): the given components move at
     /// a constant velocity.
     fn velocity(&mut self, spec: &BoundarySpec, nodes: &[usize]) -> Result<(), SceneError> {
         let src = self.src;
-        self.no_displacement_keys(spec)?;
+        refuse_displacement_keys(spec, src)?;
         let Some(v) = &spec.velocity else {
             return Err(src.at(
                 &spec.kind,
@@ -411,6 +404,33 @@ fn displacement_of<const D: usize>(
     axes_of::<D>(d, "displacement", src)
 }
 
+/// Refuses the keys of `kind = "displacement"` (`displacement`,
+/// `gradient`, `curve`) on a condition of another kind.
+///
+/// # Errors
+/// [`SceneError::Scene`] at `kind`, naming the first key given.
+pub(super) fn refuse_displacement_keys(
+    spec: &BoundarySpec,
+    src: &SceneSource,
+) -> Result<(), SceneError> {
+    for (key, present) in [
+        ("displacement", spec.displacement.is_some()),
+        ("gradient", spec.gradient.is_some()),
+        ("curve", spec.curve.is_some()),
+    ] {
+        if present {
+            return Err(src.at(
+                &spec.kind,
+                format!(
+                    "`{key}` applies to kind = displacement, not {}",
+                    boundary_kind_name(*spec.kind.get_ref())
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The name of a boundary kind in scene files.
 fn boundary_kind_name(kind: BoundaryKind) -> &'static str {
     match kind {
@@ -419,6 +439,7 @@ fn boundary_kind_name(kind: BoundaryKind) -> &'static str {
         BoundaryKind::Displacement => "displacement",
         BoundaryKind::Velocity => "velocity",
         BoundaryKind::Friction => "friction",
+        BoundaryKind::Absorbing => "absorbing",
     }
 }
 

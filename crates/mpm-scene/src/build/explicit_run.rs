@@ -12,7 +12,7 @@ use super::bodies::BuiltBodies;
 use super::explicit_keys::ExplicitKeys;
 use super::loads::ExplicitLoads;
 use super::mesh::BuiltMesh;
-use super::{BuiltMaterial, ExplicitSetup, SceneMesh, axes_of};
+use super::{AbsorbingFace, BuiltMaterial, ExplicitSetup, SceneMesh, axes_of};
 use crate::SceneError;
 use crate::format::{PointFixitySpec, Scene};
 use crate::region::Region;
@@ -152,13 +152,14 @@ fn point_fixities<const D: usize>(
 
 impl<const D: usize> ExplicitRun<D> {
     /// The run's setup with the nodal velocities `velocity_dofs` (per mesh
-    /// dof), the friction walls `walls` ((node, axis, upper face, μ)) and
-    /// the loads `loads`.
+    /// dof), the friction walls `walls` ((node, axis, upper face, μ)), the
+    /// loads `loads` and the absorbing faces `absorbing`.
     pub(super) fn setup(
         self,
         velocity_dofs: &[Option<f64>],
         walls: &[(usize, usize, bool, f64)],
         loads: ExplicitLoads<D>,
+        absorbing: &[AbsorbingFace],
     ) -> ExplicitSetup<D> {
         let k = self.keys;
         // One call per component and value (each call sorts the list).
@@ -177,6 +178,10 @@ impl<const D: usize> ExplicitRun<D> {
         }
         for &(node, axis, upper, mu) in walls {
             fixities.friction([node], axis, upper, mu);
+        }
+        for face in absorbing {
+            let nodes = face.nodes.iter().copied();
+            fixities.absorbing(nodes, face.axis, face.rho_cp, face.rho_cs);
         }
         ExplicitSetup {
             end_time: k.end_time,

@@ -9,11 +9,13 @@
 //! (`explicit_keys.rs`, `solver.rs`), the mesh (`mesh.rs`), the curves
 //! and materials (`curves.rs`, `materials.rs`), the bodies and their
 //! points (`bodies.rs`), the node sets (`node_sets.rs`), the conditions
-//! and mesh motion (`conditions.rs`, `motion.rs`), the loads
+//! and mesh motion (`conditions.rs`, `motion.rs`), the absorbing
+//! boundaries (`absorbing.rs`), the loads
 //! (`loads.rs`), the implicit solver's controls (`solver.rs`), the
 //! outputs (`outputs.rs`) and an explicit run's setup (`explicit_run.rs`).
 //! This file keeps the types they build and the checks they share.
 
+mod absorbing;
 mod bodies;
 mod cam_clay;
 mod conditions;
@@ -47,6 +49,7 @@ use crate::variant::{LockingKind, Variant};
 
 use crate::format::{Axes, Field, Scene, TransferKind};
 
+pub use absorbing::AbsorbingFace;
 pub use explicit_keys::{DEFAULT_CFL, DEFAULT_OUTPUTS};
 pub use loads::MANUFACTURED_FIELDS;
 pub use motion::SceneMotion;
@@ -310,7 +313,8 @@ pub struct ExplicitSetup<const D: usize> {
     pub gravity: SVector<f64, D>,
     /// Zero-velocity fixities of the fixed, roller and zero-displacement
     /// conditions, the constant velocities of `velocity` conditions and
-    /// the friction walls of `friction` conditions.
+    /// the friction walls of `friction` conditions and the dashpots of
+    /// `absorbing` ones.
     pub fixities: mpm_solver::VelocityFixities,
     /// Initial velocity of every point.
     pub velocity: Vec<SVector<f64, D>>,
@@ -640,6 +644,15 @@ impl<const D: usize> Problem<D> {
             initial_stress::initial_state_of_points(&scene.bodies, &bodies, &materials, src)?;
         let sets = node_sets::node_sets(&scene.node_sets, &mesh, &bodies, src)?;
         let conditions = conditions::conditions(scene, &mesh, &sets, &curves, explicit, src)?;
+        let absorbing = absorbing::absorbing_faces(
+            scene,
+            &mesh,
+            &sets,
+            &material_names,
+            &materials,
+            explicit,
+            src,
+        )?;
         let loads = loads::loads(
             &scene.loads,
             &bodies,
@@ -663,7 +676,9 @@ impl<const D: usize> Problem<D> {
             strength_reduction::strength_reduction(scene, &probes, explicit, src)?;
         let explicit =
             explicit_run::explicit_run(explicit_keys, scene, &mesh, &materials, &bodies, src)?
-                .map(|run| run.setup(&conditions.velocity_dofs, &conditions.walls, loads.explicit));
+                .map(|run| {
+                    run.setup(&conditions.velocity_dofs, &conditions.walls, loads.explicit, &absorbing)
+                });
 
         let points = bodies.points;
         Ok(Self {
