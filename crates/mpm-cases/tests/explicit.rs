@@ -1326,3 +1326,45 @@ fn absorbing_boundaries_refuse_bad_input() {
         "{e}"
     );
 }
+
+/// The absorbing column stopped after 8 of its 16 outputs and resumed
+/// writes the uninterrupted run's `energy.csv` byte for byte: the
+/// checkpoint keeps the absorbed work so far.
+#[test]
+fn the_absorbing_column_resumes_with_its_absorbed_work() {
+    let scene = scene_path("explicit_absorbing_column.toml");
+    let whole = common::fresh_dir("absorbing-whole");
+    let split = common::fresh_dir("absorbing-split");
+    for (dir, extra) in [
+        (&whole, &[][..]),
+        (&split, &["--stop-after", "8"][..]),
+        (&split, &["--resume"][..]),
+    ] {
+        let mut args = vec![
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let (ok, _, err) = mpm(&args);
+        assert!(ok, "{err}");
+    }
+    let energies = |dir: &Path| std::fs::read_to_string(dir.join("energy.csv")).unwrap();
+    let (a, b) = (energies(&whole), energies(&split));
+    assert_eq!(a, b);
+    let absorbed: f64 = a
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(7)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(absorbed > 0.0, "{a}");
+    assert_eq!(
+        summary(&whole)["final_energies"]["absorbed_work"].as_f64(),
+        Some(absorbed)
+    );
+}
