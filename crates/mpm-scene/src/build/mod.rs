@@ -675,10 +675,16 @@ impl<const D: usize> Problem<D> {
         let strength_reduction =
             strength_reduction::strength_reduction(scene, &probes, explicit, src)?;
         let explicit =
-            explicit_run::explicit_run(explicit_keys, scene, &mesh, &materials, &bodies, src)?
-                .map(|run| {
-                    run.setup(&conditions.velocity_dofs, &conditions.walls, loads.explicit, &absorbing)
-                });
+            explicit_run::explicit_run(explicit_keys, scene, &mesh, &materials, &bodies, src)?.map(
+                |run| {
+                    run.setup(
+                        &conditions.velocity_dofs,
+                        &conditions.walls,
+                        loads.explicit,
+                        &absorbing,
+                    )
+                },
+            );
 
         let points = bodies.points;
         Ok(Self {
