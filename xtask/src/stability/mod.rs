@@ -502,7 +502,7 @@ const FAMILIES: [(&str, &str); 9] = [
     ),
     (
         "explicit",
-        "The explicit solver: a fixed Δt at 1.5× and 3× the CFL limit (refused before the step, with the Courant number), a very soft / very stiff pair (E = 10³ and 10⁹ Pa: a stiffness contrast of 10⁶, each point stepping with its own wave speed) and a light / heavy pair (densities 10³ and 10⁻³: the same wave-speed contrast, one law), high-speed impacts (on a fixed wall, and on a friction wall that lets the block go and books the friction and impact losses in the energy total).",
+        "The explicit solver: a fixed Δt at 1.5× and 3× the CFL limit (refused before the step, with the Courant number), a very soft / very stiff pair (E = 10³ and 10⁹ Pa: a stiffness contrast of 10⁶, each point stepping with its own wave speed) and a light / heavy pair (densities 10³ and 10⁻³: the same wave-speed contrast, one law), high-speed impacts (on a fixed wall, on a friction wall that lets the block go and books the friction and impact losses in the energy total, and on an absorbing wall whose dashpots slow the block but do not stop it).",
     ),
     (
         "mesh",
