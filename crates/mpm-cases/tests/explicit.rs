@@ -1265,13 +1265,15 @@ fn an_absorbing_base_takes_the_columns_wave() {
 
 /// What `kind = "absorbing"` refuses, located: no `material`, an unknown
 /// one, one without E and ν (Cam-Clay), a set that is not a grid face,
-/// the keys of other kinds, `material` on another kind, and the implicit
-/// solver.
+/// the keys of other kinds, `material` or `spring` on another kind, a
+/// negative or unknown spring stiffness, and the implicit solver.
 #[test]
 fn absorbing_boundaries_refuse_bad_input() {
     let base = "kind = \"absorbing\"\nmaterial = \"soil\"";
     let with = |replacement: &str| COLUMN.replacen(base, replacement, 1);
     assert_eq!(build(COLUMN), "");
+    let springs = format!("{base}\nspring = {{ normal = 1e7, tangential = 5e6 }}");
+    assert_eq!(build(&with(&springs)), "");
     let cases = [
         (
             "kind = \"absorbing\"".to_owned(),
@@ -1288,6 +1290,18 @@ fn absorbing_boundaries_refuse_bad_input() {
         (
             "kind = \"roller\"\nmaterial = \"soil\"".to_owned(),
             "s.toml:52:8: `material` applies to kind = absorbing, not roller",
+        ),
+        (
+            "kind = \"roller\"\nspring = { normal = 1e6 }".to_owned(),
+            "s.toml:52:8: `spring` applies to kind = absorbing, not roller",
+        ),
+        (
+            format!("{base}\nspring = {{ normal = -1.0 }}"),
+            "s.toml:54:10: spring = { normal = -1, tangential = 0 }: the stiffnesses per unit area (Pa/m) must be finite and non-negative",
+        ),
+        (
+            format!("{base}\nspring = {{ normal = 1e6, along = 2.0 }}"),
+            "s.toml:54:",
         ),
     ];
     for (replacement, expected) in cases {

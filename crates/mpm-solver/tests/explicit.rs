@@ -1370,6 +1370,24 @@ struct ColumnFigures {
     residual: f64,
 }
 
+/// The points of a column two cells wide of `spacing` and `cells` high
+/// from y = 0, 2 × 2 per cell, of density `rho`: their initial positions
+/// and the points.
+fn column_points<T: Transfer<2>>(
+    spacing: Vector2<f64>,
+    cells: usize,
+    rho: f64,
+) -> (Vec<Vector2<f64>>, PointsFor<2, NeoHookean, T>) {
+    let d = spacing / 2.0;
+    let x0: Vec<Vector2<f64>> = (0..2 * cells)
+        .flat_map(|j| (0..4).map(move |i| Vector2::new(i as f64 + 0.5, j as f64 + 0.5)))
+        .map(|ij| ij.component_mul(&d))
+        .collect();
+    let vol = vec![d.x * d.y; x0.len()];
+    let points = ExplicitPoints::new(x0.clone(), vol, rho).unwrap();
+    (x0, points)
+}
+
 /// A 1D column under a step load (issue 44's absorbing column): 1 m of
 /// linear elastic material (ϱ = 2000 kg/m³, E = 10 MPa, ν = 0.3: c_p =
 /// 82.04 m/s, c_s = 43.85 m/s) two cells wide (5 mm high, 50 mm wide,
@@ -1387,14 +1405,7 @@ fn absorbing_column<T: Transfer<2>>(transfer: T, along: usize, absorbing: bool) 
     let (spacing, height, cells) = (Vector2::new(0.05, 0.005), 1.0, 200);
     let width = 2.0 * spacing.x;
     let grid = RegularGrid::new(Vector2::zeros(), spacing, [2, cells + 4]).unwrap();
-    let d = spacing / 2.0;
-    let x0: Vec<Vector2<f64>> = (0..2 * cells)
-        .flat_map(|j| (0..4).map(move |i| Vector2::new(i as f64 + 0.5, j as f64 + 0.5)))
-        .map(|ij| ij.component_mul(&d))
-        .collect();
-    let vol = vec![d.x * d.y; x0.len()];
-    let mut points: PointsFor<2, NeoHookean, T> =
-        ExplicitPoints::new(x0.clone(), vol, rho).unwrap();
+    let (x0, mut points) = column_points::<T>(spacing, cells, rho);
     let top = x0.iter().map(|x| x.y).fold(0.0, f64::max);
     let on_top: Vec<usize> = (0..x0.len()).filter(|&p| x0[p].y == top).collect();
     let mut share = Vector2::zeros();
@@ -1529,14 +1540,7 @@ fn column_on_springs(spring: f64, transits: f64) -> ([f64; 2], f64) {
     let (spacing, height, cells) = (Vector2::new(0.05, 0.02), 1.0, 50);
     // A row of cells below the base so the points may sink into it.
     let grid = RegularGrid::new(Vector2::new(0.0, -0.02), spacing, [2, cells + 3]).unwrap();
-    let d = spacing / 2.0;
-    let x0: Vec<Vector2<f64>> = (0..2 * cells)
-        .flat_map(|j| (0..4).map(move |i| Vector2::new(i as f64 + 0.5, j as f64 + 0.5)))
-        .map(|ij| ij.component_mul(&d))
-        .collect();
-    let vol = vec![d.x * d.y; x0.len()];
-    let mut points: PointsFor<2, NeoHookean, Taylor> =
-        ExplicitPoints::new(x0.clone(), vol, rho).unwrap();
+    let (_, mut points) = column_points::<Taylor>(spacing, cells, rho);
     let mut fixities = VelocityFixities::new();
     let nodes = grid.nodes_per_axis();
     for i in [0, nodes[0] - 1] {

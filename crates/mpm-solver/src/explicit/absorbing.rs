@@ -63,10 +63,16 @@ impl Dashpot {
     /// The spring of `component`: $K_n$ on the normal, $K_t$ on the others.
     #[inline]
     pub fn spring(&self, component: usize) -> f64 {
+        self.along(component, self.normal_spring, self.tangential_spring)
+    }
+
+    /// `normal` on the face's normal component, `tangential` on the others.
+    #[inline]
+    fn along(&self, component: usize, normal: f64, tangential: f64) -> f64 {
         if component == self.axis {
-            self.normal_spring
+            normal
         } else {
-            self.tangential_spring
+            tangential
         }
     }
 
@@ -85,11 +91,7 @@ impl Dashpot {
     /// The dashpot of `component`: $C_n$ on the normal, $C_t$ on the others.
     #[inline]
     pub fn coefficient(&self, component: usize) -> f64 {
-        if component == self.axis {
-            self.normal
-        } else {
-            self.tangential
-        }
+        self.along(component, self.normal, self.tangential)
     }
 
     /// Whether the coefficients are finite and non-negative.
