@@ -450,7 +450,7 @@ fn summary(dir: &Path) -> serde_json::Value {
 /// taken in another order), and every explicit output.
 #[test]
 fn one_and_two_threads_give_the_same_energies() {
-    let header = "time,kinetic,strain,gravitational,external_work,friction_work,wall_work,absorbed_work,total";
+    let header = "time,kinetic,strain,gravitational,external_work,friction_work,wall_work,absorbed_work,spring_energy,total";
     let mut runs = Vec::new();
     for threads in ["1", "2"] {
         let dir = common::fresh_dir(&format!("explicit-threads-{threads}"));
@@ -474,9 +474,13 @@ fn one_and_two_threads_give_the_same_energies() {
         assert_eq!(rows[0][0], 0.0);
         assert!((rows[12][0] - 30.0).abs() < 1e-9);
         for row in &rows {
-            assert_eq!((row[5], row[6], row[7]), (0.0, 0.0, 0.0), "no wall");
-            let total = row[1] + row[2] + row[3] + row[5] + row[6] + row[7] - row[4];
-            assert!((row[8] - total).abs() < 1e-15, "{row:?}");
+            assert_eq!(
+                (row[5], row[6], row[7], row[8]),
+                (0.0, 0.0, 0.0, 0.0),
+                "no wall"
+            );
+            let total = row[1] + row[2] + row[3] + row[5] + row[6] + row[7] + row[8] - row[4];
+            assert!((row[9] - total).abs() < 1e-15, "{row:?}");
         }
         let probe = csv_rows(&dir.join("probe_tip.csv"), "time,ux,uy");
         assert_eq!(probe.len(), 13);
@@ -1343,42 +1347,56 @@ fn absorbing_boundaries_refuse_bad_input() {
 
 /// The absorbing column stopped after 8 of its 16 outputs and resumed
 /// writes the uninterrupted run's `energy.csv` byte for byte: the
-/// checkpoint keeps the absorbed work so far.
+/// checkpoint keeps the absorbed work so far and, with a spring layer
+/// (`spring = { normal = 1e7, tangential = 5e6 }`), its nodes' spring
+/// displacements.
 #[test]
 fn the_absorbing_column_resumes_with_its_absorbed_work() {
-    let scene = scene_path("explicit_absorbing_column.toml");
-    let whole = common::fresh_dir("absorbing-whole");
-    let split = common::fresh_dir("absorbing-split");
-    for (dir, extra) in [
-        (&whole, &[][..]),
-        (&split, &["--stop-after", "8"][..]),
-        (&split, &["--resume"][..]),
+    let springs = common::fresh_dir("absorbing-springs-scene").join("springs.toml");
+    std::fs::write(
+        &springs,
+        COLUMN.replacen(
+            "material = \"soil\"\n\n[solver]",
+            "material = \"soil\"\nspring = { normal = 1e7, tangential = 5e6 }\n\n[solver]",
+            1,
+        ),
+    )
+    .unwrap();
+    for (scene, name, with_springs) in [
+        (
+            scene_path("explicit_absorbing_column.toml"),
+            "absorbing",
+            false,
+        ),
+        (springs, "absorbing-springs", true),
     ] {
-        let mut args = vec![
-            "run",
-            scene.to_str().unwrap(),
-            "--out",
-            dir.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        let (ok, _, err) = mpm(&args);
-        assert!(ok, "{err}");
+        let whole = common::fresh_dir(&format!("{name}-whole"));
+        let split = common::fresh_dir(&format!("{name}-split"));
+        for (dir, extra) in [
+            (&whole, &[][..]),
+            (&split, &["--stop-after", "8"][..]),
+            (&split, &["--resume"][..]),
+        ] {
+            let mut args = vec![
+                "run",
+                scene.to_str().unwrap(),
+                "--out",
+                dir.to_str().unwrap(),
+            ];
+            args.extend(extra);
+            let (ok, _, err) = mpm(&args);
+            assert!(ok, "{err}");
+        }
+        let energies = |dir: &Path| std::fs::read_to_string(dir.join("energy.csv")).unwrap();
+        let (a, b) = (energies(&whole), energies(&split));
+        assert_eq!(a, b);
+        let last: Vec<f64> = (a.lines().last().unwrap().split(','))
+            .map(|x| x.parse().unwrap())
+            .collect();
+        let (absorbed, spring) = (last[7], last[8]);
+        assert!(absorbed > 0.0 && (spring > 0.0) == with_springs, "{a}");
+        let e = &summary(&whole)["final_energies"];
+        assert_eq!(e["absorbed_work"].as_f64(), Some(absorbed));
+        assert_eq!(e["spring_energy"].as_f64(), Some(spring));
     }
-    let energies = |dir: &Path| std::fs::read_to_string(dir.join("energy.csv")).unwrap();
-    let (a, b) = (energies(&whole), energies(&split));
-    assert_eq!(a, b);
-    let absorbed: f64 = a
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .nth(7)
-        .unwrap()
-        .parse()
-        .unwrap();
-    assert!(absorbed > 0.0, "{a}");
-    assert_eq!(
-        summary(&whole)["final_energies"]["absorbed_work"].as_f64(),
-        Some(absorbed)
-    );
 }
