@@ -508,11 +508,11 @@ fn one_and_two_threads_give_the_same_energies() {
         assert!(s["wall_time_s"].as_f64().unwrap() > 0.0);
         let drift = s["energy_drift"].as_f64().unwrap();
         assert!(drift < 0.0 && drift > -0.03, "{drift}");
-        assert_eq!(s["final_energies"]["total"].as_f64().unwrap(), rows[12][8]);
+        assert_eq!(s["final_energies"]["total"].as_f64().unwrap(), rows[12][9]);
         runs.push(rows);
     }
     for (a, b) in runs[0].iter().zip(&runs[1]) {
-        let scale = a[8].abs();
+        let scale = a[9].abs();
         for (x, y) in a.iter().zip(b) {
             assert!((x - y).abs() <= 1e-9 * scale, "{a:?} against {b:?}");
         }
@@ -790,7 +790,7 @@ fn a_soft_and_a_stiff_disk_run_as_a_material_set_and_resume() {
         .skip(1)
         .map(|l| {
             let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            (v[0], v[8])
+            (v[0], v[9])
         })
         .collect();
     let initial = totals[0].1;

@@ -196,7 +196,9 @@ pub fn spring_energy<const D: usize>(
                 .map(|c| 0.5 * d.spring(c) * u[c] * u[c])
                 .sum::<f64>()
         })
-        .sum()
+        // From +0: an empty `sum` of floats is −0, which the summary
+        // would write as such.
+        .fold(0.0, |total, e| total + e)
 }
 
 #[cfg(test)]
