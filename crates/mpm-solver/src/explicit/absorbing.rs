@@ -259,4 +259,37 @@ mod tests {
         assert_eq!(grid.velocity[0].new, Vector2::new(1.0, -1.5));
         assert_eq!(work, 0.0);
     }
+
+    /// With springs: v' = (m ṽ − Δt K u)/(m + Δt C + Δt² K) per free
+    /// component, u advances by Δt v' on counted nodes only, the work is
+    /// Σ Δt (C + ½ Δt K) v'², and the stored energy ½ K u².
+    #[test]
+    fn springs_and_dashpots_are_solved_together() {
+        let mut grid = GridState::<2>::new(1);
+        grid.mass[0] = 2.0;
+        grid.velocity[0].new = SVector::from([1.0, -3.0]);
+        grid.hi = 1;
+        let mut f = VelocityFixities::new();
+        f.absorbing_with_springs([(0, 0.5)], 1, (8.0, 4.0), (16.0, 4.0));
+        f.finish();
+        let dt = 0.5;
+        let mut u = vec![SVector::from([0.5, -1.0])];
+        // C_n = 4, C_t = 2, K_n = 8, K_t = 2.
+        let work = dashpots(&mut grid, f.dashpots(), &mut u, dt, |_| true);
+        let vx = (2.0 * 1.0 - dt * 2.0 * 0.5) / (2.0 + dt * 2.0 + dt * dt * 2.0);
+        let vy = (2.0 * -3.0 - dt * 8.0 * -1.0) / (2.0 + dt * 4.0 + dt * dt * 8.0);
+        let v = grid.velocity[0].new;
+        assert!((v - Vector2::new(vx, vy)).norm() < 1e-15, "{v}");
+        assert!((u[0] - Vector2::new(0.5 + dt * vx, -1.0 + dt * vy)).norm() < 1e-15);
+        let expected = dt * ((2.0 + 0.5 * dt * 2.0) * vx * vx + (4.0 + 0.5 * dt * 8.0) * vy * vy);
+        assert!((work - expected).abs() < 1e-14);
+        let stored = 0.5 * 2.0 * u[0].x * u[0].x + 0.5 * 8.0 * u[0].y * u[0].y;
+        assert!((spring_energy(f.dashpots(), &u) - stored).abs() < 1e-15);
+        let before = u[0];
+        assert_eq!(
+            dashpots(&mut grid, f.dashpots(), &mut u, dt, |_| false),
+            0.0
+        );
+        assert_eq!(u[0], before);
+    }
 }

@@ -238,8 +238,8 @@ where
     /// # Errors
     /// Invalid options; a fixity on a node or component that does not
     /// exist; a friction wall on a node or axis that does not exist or
-    /// with a coefficient that is negative or not finite; a dashpot
-    /// likewise.
+    /// with a coefficient that is negative or not finite; a dashpot or
+    /// its springs likewise.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         basis: B,
@@ -285,8 +285,8 @@ where
             .find(|d| d.node >= node_count || d.axis >= D || !d.is_valid())
         {
             return Err(SolverError::InvalidInput(format!(
-                "absorbing boundary at node {} normal to axis {} with dashpots C_n = {}, C_t = {}: the mesh has {node_count} nodes of {D} axes and the dashpots must be finite and non-negative",
-                d.node, d.axis, d.normal, d.tangential
+                "absorbing boundary at node {} normal to axis {} with dashpots C_n = {}, C_t = {} and springs K_n = {}, K_t = {}: the mesh has {node_count} nodes of {D} axes and the dashpots and springs must be finite and non-negative",
+                d.node, d.axis, d.normal, d.tangential, d.normal_spring, d.tangential_spring
             )));
         }
         let node_position = if T::TAYLOR {
