@@ -132,7 +132,7 @@ pub struct ExplicitSummary<P: Serialize> {
     pub stage_times_s: serde_json::Value,
     /// Energies at t = 0 (`kinetic`, `strain`, `gravitational`,
     /// `external_work`, `friction_work`, `wall_work`, `absorbed_work`,
-    /// `total`).
+    /// `spring_energy`, `total`).
     pub initial_energies: serde_json::Value,
     /// Energies at the end.
     pub final_energies: serde_json::Value,

@@ -476,17 +476,18 @@ fn friction_walls_on_ranks_book_their_work_once() {
 }
 
 /// An absorbing floor (issue 44) under the collapsing column, its dashpots
-/// on nodes that several ranks share: each node's absorbed work is booked
-/// by its owner and summed over the ranks, so the ranks' absorbed work is
-/// the one process's to 1e-10 (and 1 rank's bit for bit), as the motion
-/// is within issue 42's bounds. The floor is a roller as well, so only
-/// its tangential dashpots act (without the spring layer the column would
-/// sink through an absorbing floor at g H / c_p).
+/// and tangential springs on nodes that several ranks share: each node's
+/// absorbed work is booked by its owner and summed over the ranks, each
+/// spring's displacement advanced by its owner and shared, so the ranks'
+/// absorbed work and spring energy are the one process's to 1e-10 (and 1
+/// rank's bit for bit), as the motion is within issue 42's bounds. The
+/// floor is a roller as well, so only its tangential dashpots and springs
+/// act.
 #[test]
 fn an_absorbing_floor_books_its_work_once_on_ranks() {
     let floor = "set = \"y_min\"\nkind = \"fixed\"";
     assert!(COLLAPSE.contains(floor));
-    let dashpots = "\n\n[[boundary]]\nset = \"y_min\"\nkind = \"absorbing\"\nmaterial = \"soil\"";
+    let dashpots = "\n\n[[boundary]]\nset = \"y_min\"\nkind = \"absorbing\"\nmaterial = \"soil\"\nspring = { tangential = 1e7 }";
     let absorbing = COLLAPSE.replacen(
         floor,
         &format!("set = \"y_min\"\nkind = \"roller\"{dashpots}"),
@@ -499,25 +500,40 @@ fn an_absorbing_floor_books_its_work_once_on_ranks() {
     let (scene, source) = scene::parse(&absorbing, "absorbing.toml", &set).unwrap();
     let problem = Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap();
     let single = matches_one_process_on_ranks(&problem, "absorbing floor");
-    let absorbed = |seen: &Seen| {
-        seen.energies
-            .iter()
-            .map(|e| e.absorbed_work)
+    let part = |seen: &Seen, spring: bool| {
+        (seen.energies.iter())
+            .map(|e| {
+                if spring {
+                    e.spring_energy
+                } else {
+                    e.absorbed_work
+                }
+            })
             .collect::<Vec<_>>()
     };
-    let reference = absorbed(&single);
-    let scale = reference.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    assert!(scale > 0.0, "the floor absorbs: {reference:?}");
-    for size in [2, 4] {
-        let ranks = absorbed(&on_ranks(&problem, size));
-        let d = (reference.iter().zip(&ranks)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        eprintln!(
-            "absorbing floor, {size} ranks: absorbed work within {:.1e}",
-            d / scale
-        );
+    for spring in [false, true] {
+        let reference = part(&single, spring);
+        let scale = reference.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         assert!(
-            d <= 1e-10 * scale,
-            "{size} ranks: {ranks:?} against {reference:?}"
+            scale > 0.0,
+            "the floor absorbs and its springs store: {reference:?}"
         );
+        for size in [2, 4] {
+            let ranks = part(&on_ranks(&problem, size), spring);
+            let d = (reference.iter().zip(&ranks)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            eprintln!(
+                "absorbing floor, {size} ranks: {} within {:.1e}",
+                if spring {
+                    "spring energy"
+                } else {
+                    "absorbed work"
+                },
+                d / scale
+            );
+            assert!(
+                d <= 1e-10 * scale,
+                "{size} ranks: {ranks:?} against {reference:?}"
+            );
+        }
     }
 }

@@ -97,7 +97,7 @@ enum Cost {
 }
 
 /// The base scenes (in `scenes/`).
-const BASES: [(&str, Cost); 19] = [
+const BASES: [(&str, Cost); 20] = [
     ("features.toml", Cost::Run),
     ("two_layer_column.toml", Cost::Run),
     ("coombs2020_column.toml", Cost::Run),
@@ -111,6 +111,7 @@ const BASES: [(&str, Cost); 19] = [
     ("explicit_cube.toml", Cost::Build),
     ("sliding_block.toml", Cost::Run),
     ("explicit_absorbing_column.toml", Cost::Run),
+    ("explicit_absorbing_gravity.toml", Cost::Run),
     ("cube_gmsh.toml", Cost::Run),
     ("wang2021_stretch.toml", Cost::Run),
     ("wang2021_footing.toml", Cost::Build),

@@ -422,8 +422,12 @@ pub(crate) trait Stepper<const D: usize> {
     /// The points' evolving state as numbers ([`write_points`]).
     fn flat_points(&self) -> Vec<f64>;
     /// The points of checkpoint `c` (whose clock is `clock`), the solver
-    /// set to its time.
+    /// set to its time and its absorbing boundaries' springs to their
+    /// displacements.
     fn resume(&mut self, c: &Checkpoint, clock: &Clock) -> Result<(), SolverError>;
+    /// The absorbing boundaries' spring displacements, D numbers per
+    /// absorbing node (the same on every rank).
+    fn spring_displacements(&self) -> Vec<f64>;
     /// Wall time per stage so far.
     fn stage_times(&self) -> ExplicitStageTimes;
     /// The global ids of the points held here (their indices in the
@@ -540,7 +544,18 @@ where
             clock.external_work,
         );
         self.solver.resume_wall_work(clock.wall_work);
+        let springs = Clock::springs(c)?;
+        // A checkpoint without the section has no displaced spring.
+        if !springs.is_empty() {
+            let u = springs.chunks(D).map(SVector::from_column_slice).collect();
+            self.solver.resume_spring_displacements(u)?;
+        }
         Ok(())
+    }
+
+    fn spring_displacements(&self) -> Vec<f64> {
+        let u = self.solver.spring_displacements();
+        u.iter().flat_map(|u| u.iter().copied()).collect()
     }
 
     fn stage_times(&self) -> ExplicitStageTimes {
@@ -606,7 +621,7 @@ fn time_loop<const D: usize>(
             let clock = Clock::from_checkpoint(c)?;
             run.resume(c, &clock)?;
             if let Some(spread) = &mut out.spread {
-                spread.resume(run, &c.case_state[Clock::LEN..], clock.external_work)?;
+                spread.resume(run, Clock::held(c)?, clock.external_work)?;
             }
             wall.earlier = c.wall_time_s;
             clock
@@ -971,7 +986,9 @@ impl Wall {
 /// What an explicit checkpoint keeps besides the points and the step
 /// count: the output reached, the work of the applied forces, what the
 /// friction walls and absorbing boundaries took, the initial energies and
-/// the energy scale (in [`Checkpoint::case_state`]).
+/// the energy scale (in [`Checkpoint::case_state`], followed by the
+/// spring section — its length, then the absorbing boundaries' spring
+/// displacements — and, on several ranks, how they held the points).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Clock {
     index: usize,
@@ -998,6 +1015,31 @@ impl Clock {
             self.wall_work.impact,
             self.wall_work.absorbed,
         ]
+    }
+
+    /// The spring section of checkpoint `c`: after the clock, the count
+    /// of numbers then the absorbing nodes' spring displacements (empty
+    /// in a checkpoint without the section).
+    fn springs(c: &Checkpoint) -> Result<&[f64], SolverError> {
+        let s = &c.case_state[Self::LEN.min(c.case_state.len())..];
+        let Some((&n, rest)) = s.split_first() else {
+            return Ok(&[]);
+        };
+        if !(n >= 0.0 && n.fract() == 0.0 && n as usize <= rest.len()) {
+            return Err(SolverError::InvalidInput(format!(
+                "the checkpoint's spring section claims {n} numbers of {}",
+                rest.len()
+            )));
+        }
+        Ok(&rest[..n as usize])
+    }
+
+    /// What follows the clock and the spring section in checkpoint `c`:
+    /// how the ranks held the points.
+    fn held(c: &Checkpoint) -> Result<&[f64], SolverError> {
+        let springs = Self::springs(c)?.len();
+        let start = (Self::LEN + 1 + springs).min(c.case_state.len());
+        Ok(&c.case_state[start..])
     }
 
     fn from_checkpoint(c: &Checkpoint) -> Result<Self, SolverError> {
@@ -1052,6 +1094,9 @@ fn snapshot<const D: usize>(
             None => (run.flat_points(), Vec::new()),
         };
         let mut case_state = clock.to_case_state();
+        let springs = run.spring_displacements();
+        case_state.push(springs.len() as f64);
+        case_state.extend(springs);
         case_state.extend(held);
         snap.checkpoint = Some(Checkpoint {
             state: RunState {

@@ -529,6 +529,25 @@ pub struct BoundarySpec {
     /// per unit area.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<Spanned<String>>,
+    /// For `absorbing` (explicit solver): a spring layer behind the
+    /// dashpots, `{ normal = k_n, tangential = k_t }` per unit area
+    /// (Pa/m, each ≥ 0, a missing one 0), so a body under gravity rests
+    /// on the boundary instead of sinking through it. Default: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spring: Option<Spanned<SpringSpec>>,
+}
+
+/// The spring layer of an absorbing boundary: stiffnesses per unit area
+/// (Pa/m) on the normal and on each tangential component.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    /// k_n (Pa/m).
+    #[serde(default)]
+    pub normal: f64,
+    /// k_t (Pa/m).
+    #[serde(default)]
+    pub tangential: f64,
 }
 
 /// `[[point_fixity]]`: material-point fixities (explicit solver; the

@@ -413,6 +413,7 @@ impl BoundarySpec {
             velocity: None,
             friction: None,
             material: None,
+            spring: None,
         }
     }
 

@@ -413,6 +413,7 @@ fn energies_json(e: &mpm_solver::explicit::Energies) -> Value {
         "friction_work": e.friction_work,
         "wall_work": e.wall_work,
         "absorbed_work": e.absorbed_work,
+        "spring_energy": e.spring_energy,
         "total": e.total(),
     })
 }
@@ -449,7 +450,7 @@ where
     let mut rebalances = Vec::new();
     obs.show_time();
     obs.writer.set_vtu_options(vtu_options(problem, true));
-    const ENERGY_HEADER: [&str; 9] = [
+    const ENERGY_HEADER: [&str; 10] = [
         "time",
         "kinetic",
         "strain",
@@ -458,6 +459,7 @@ where
         "friction_work",
         "wall_work",
         "absorbed_work",
+        "spring_energy",
         "total",
     ];
     let axes = ["x", "y", "z"];
@@ -491,6 +493,7 @@ where
                 e.friction_work,
                 e.wall_work,
                 e.absorbed_work,
+                e.spring_energy,
                 e.total(),
             ]
             .map(CsvValue::from);

@@ -10,7 +10,7 @@ use super::mesh::BuiltMesh;
 use super::node_sets::NodeSets;
 use super::{BuiltMaterial, SceneMesh, face_name};
 use crate::SceneError;
-use crate::format::{BoundaryKind, BoundarySpec, Scene};
+use crate::format::{BoundaryKind, BoundarySpec, Scene, SpringSpec};
 use crate::source::SceneSource;
 
 /// One absorbing face: its nodes with their tributary areas, its normal
@@ -25,6 +25,9 @@ pub struct AbsorbingFace {
     pub rho_cp: f64,
     /// ρ c_s (Pa·s/m).
     pub rho_cs: f64,
+    /// The spring layer's (k_n, k_t) per unit area (Pa/m; zero without
+    /// `spring`).
+    pub springs: (f64, f64),
 }
 
 /// The absorbing faces of `scene`'s boundaries on `mesh`, in file order
@@ -35,7 +38,8 @@ pub struct AbsorbingFace {
 /// [`SceneError::Scene`] at `kind` for the implicit solver, without
 /// `material`, or with a key of another kind; at `material` when no
 /// material has the name or it has no Young's modulus and Poisson's ratio
-/// (`modified_cam_clay`); at `set` when it is not a face of a grid.
+/// (`modified_cam_clay`); at `set` when it is not a face of a grid; at
+/// `spring` when a stiffness is negative or not finite.
 pub(super) fn absorbing_faces<const D: usize>(
     scene: &Scene,
     mesh: &BuiltMesh<D>,
@@ -57,6 +61,7 @@ pub(super) fn absorbing_faces<const D: usize>(
             }
             super::conditions::refuse_displacement_keys(spec, src)?;
             let (rho_cp, rho_cs) = impedances(spec, material_names, materials, src)?;
+            let springs = springs(spec, src)?;
             let SceneMesh::Grid(grid) = &mesh.mesh else {
                 return Err(src.at(&spec.set, "kind = absorbing needs a face of a grid"));
             };
@@ -79,6 +84,7 @@ pub(super) fn absorbing_faces<const D: usize>(
                 axis,
                 rho_cp,
                 rho_cs,
+                springs,
             })
         })
         .collect()
@@ -113,4 +119,25 @@ fn impedances(
     let constrained = e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
     let shear = e / (2.0 * (1.0 + nu));
     Ok(((constrained * rho).sqrt(), (shear * rho).sqrt()))
+}
+
+/// The boundary's spring layer (k_n, k_t), (0, 0) without `spring`.
+fn springs(spec: &BoundarySpec, src: &SceneSource) -> Result<(f64, f64), SceneError> {
+    let Some(spring) = &spec.spring else {
+        return Ok((0.0, 0.0));
+    };
+    let SpringSpec { normal, tangential } = *spring.get_ref();
+    if [normal, tangential]
+        .iter()
+        .all(|k| k.is_finite() && *k >= 0.0)
+    {
+        Ok((normal, tangential))
+    } else {
+        Err(src.at(
+            spring,
+            format!(
+                "spring = {{ normal = {normal}, tangential = {tangential} }}: the stiffnesses per unit area (Pa/m) must be finite and non-negative"
+            ),
+        ))
+    }
 }

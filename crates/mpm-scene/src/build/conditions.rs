@@ -119,6 +119,7 @@ impl<const D: usize> Held<'_, D> {
         for (key, present, owner) in [
             ("velocity", spec.velocity.is_some(), BoundaryKind::Velocity),
             ("material", spec.material.is_some(), BoundaryKind::Absorbing),
+            ("spring", spec.spring.is_some(), BoundaryKind::Absorbing),
         ] {
             if present && kind != owner {
                 return Err(src.at(

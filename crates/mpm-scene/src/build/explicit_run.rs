@@ -181,7 +181,12 @@ impl<const D: usize> ExplicitRun<D> {
         }
         for face in absorbing {
             let nodes = face.nodes.iter().copied();
-            fixities.absorbing(nodes, face.axis, face.rho_cp, face.rho_cs);
+            fixities.absorbing_with_springs(
+                nodes,
+                face.axis,
+                (face.rho_cp, face.rho_cs),
+                face.springs,
+            );
         }
         ExplicitSetup {
             end_time: k.end_time,

@@ -26,11 +26,15 @@ pub struct Energies {
     /// Energy absorbed by the absorbing boundaries since the start
     /// ([`super::WallWork::absorbed`]).
     pub absorbed_work: f64,
+    /// Energy stored in the absorbing boundaries' spring layer,
+    /// $\sum \tfrac12 K u^2$ ([`super::absorbing::spring_energy`]).
+    pub spring_energy: f64,
 }
 
 impl Energies {
     /// Kinetic + strain + gravitational + what the friction walls and
-    /// the absorbing boundaries took − external work: constant for a
+    /// the absorbing boundaries took + the energy in their springs −
+    /// external work: constant for a
     /// conservative scheme.
     pub fn total(&self) -> f64 {
         self.kinetic
@@ -39,6 +43,7 @@ impl Energies {
             + self.friction_work
             + self.wall_work
             + self.absorbed_work
+            + self.spring_energy
             - self.external_work
     }
 

@@ -122,11 +122,23 @@ impl VelocityFixities {
         rho_cp: f64,
         rho_cs: f64,
     ) -> &mut Self {
-        self.dashpots.extend(
-            nodes
-                .into_iter()
-                .map(|(node, area)| Dashpot::new(node, axis, area, rho_cp, rho_cs)),
-        );
+        self.absorbing_with_springs(nodes, axis, (rho_cp, rho_cs), (0.0, 0.0))
+    }
+
+    /// As [`Self::absorbing`], the impedances `(ρ c_p, ρ c_s)` (Pa·s/m),
+    /// with a spring layer behind the dashpots of stiffnesses per unit
+    /// area `(k_n, k_t)` (Pa/m; [`Dashpot::with_springs`]): each node
+    /// carries the forces $-k A_i u$ of its accumulated displacement $u$.
+    pub fn absorbing_with_springs(
+        &mut self,
+        nodes: impl IntoIterator<Item = (usize, f64)>,
+        axis: usize,
+        (rho_cp, rho_cs): (f64, f64),
+        (k_n, k_t): (f64, f64),
+    ) -> &mut Self {
+        self.dashpots.extend(nodes.into_iter().map(|(node, area)| {
+            Dashpot::new(node, axis, area, rho_cp, rho_cs).with_springs(area, k_n, k_t)
+        }));
         self
     }
 

@@ -2,6 +2,7 @@
 //! 31), updated velocity (eq. 32), the velocity fixities, the friction
 //! walls and the absorbing boundaries.
 
+use nalgebra::SVector;
 use rayon::prelude::*;
 
 use super::absorbing;
@@ -47,7 +48,8 @@ impl WallWork {
 /// acceleration as the notes require (a fixity on a node without mass has
 /// no effect: no point reads it); then the friction walls
 /// ([`friction_walls`]) and the absorbing boundaries
-/// ([`absorbing::dashpots`]). Returns what the walls and dashpots took
+/// ([`absorbing::dashpots`]) with their springs' displacements `springs`
+/// (one per dashpot). Returns what the walls and dashpots took
 /// from the nodes for which `counted` is true (on several ranks, those the
 /// rank owns).
 pub fn update<const D: usize>(
@@ -55,6 +57,7 @@ pub fn update<const D: usize>(
     grid: &mut GridState<D>,
     dt: f64,
     fixities: &VelocityFixities,
+    springs: &mut [SVector<f64, D>],
     counted: impl Fn(usize) -> bool,
 ) -> WallWork {
     let lo = buffers.iter().map(|b| b.lo).min().unwrap_or(usize::MAX);
@@ -105,7 +108,7 @@ pub fn update<const D: usize>(
     }
     let walls = friction_walls(grid, fixities.walls(), &counted);
     WallWork {
-        absorbed: absorbing::dashpots(grid, fixities.dashpots(), dt, &counted),
+        absorbed: absorbing::dashpots(grid, fixities.dashpots(), springs, dt, &counted),
         ..walls
     }
 }

@@ -210,6 +210,9 @@ where
     /// What the friction walls and absorbing boundaries took so far (over
     /// every rank).
     wall_work: WallWork,
+    /// The accumulated displacement of each absorbing node's spring
+    /// layer, one per dashpot of `fixities` (the same on every rank).
+    spring_displacement: Vec<SVector<f64, D>>,
     stage_times: ExplicitStageTimes,
     fixed_start: Vec<f64>,
     /// The held points' (node, weight) pairs, and where each point's pairs end.
@@ -235,8 +238,8 @@ where
     /// # Errors
     /// Invalid options; a fixity on a node or component that does not
     /// exist; a friction wall on a node or axis that does not exist or
-    /// with a coefficient that is negative or not finite; a dashpot
-    /// likewise.
+    /// with a coefficient that is negative or not finite; a dashpot or
+    /// its springs likewise.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         basis: B,
@@ -282,8 +285,8 @@ where
             .find(|d| d.node >= node_count || d.axis >= D || !d.is_valid())
         {
             return Err(SolverError::InvalidInput(format!(
-                "absorbing boundary at node {} normal to axis {} with dashpots C_n = {}, C_t = {}: the mesh has {node_count} nodes of {D} axes and the dashpots must be finite and non-negative",
-                d.node, d.axis, d.normal, d.tangential
+                "absorbing boundary at node {} normal to axis {} with dashpots C_n = {}, C_t = {} and springs K_n = {}, K_t = {}: the mesh has {node_count} nodes of {D} axes and the dashpots and springs must be finite and non-negative",
+                d.node, d.axis, d.normal, d.tangential, d.normal_spring, d.tangential_spring
             )));
         }
         let node_position = if T::TAYLOR {
@@ -291,6 +294,7 @@ where
         } else {
             Vec::new()
         };
+        let spring_displacement = vec![SVector::zeros(); fixities.dashpots().len()];
         Ok(Self {
             basis,
             law,
@@ -315,6 +319,7 @@ where
             steps: 0,
             external_work: 0.0,
             wall_work: WallWork::default(),
+            spring_displacement,
             stage_times: ExplicitStageTimes::default(),
             fixed_start: Vec::new(),
             held_stencils: (Vec::new(), Vec::new()),
@@ -364,6 +369,7 @@ where
             steps: self.steps,
             external_work: self.external_work,
             wall_work: self.wall_work,
+            spring_displacement: self.spring_displacement,
             stage_times: self.stage_times,
             fixed_start: self.fixed_start,
             held_stencils: self.held_stencils,
@@ -444,6 +450,37 @@ where
         self.wall_work = work;
     }
 
+    /// The accumulated displacements of the absorbing boundaries' spring
+    /// layer, one per dashpot in the order of
+    /// [`VelocityFixities::dashpots`] (zero without springs).
+    pub fn spring_displacements(&self) -> &[SVector<f64, D>] {
+        &self.spring_displacement
+    }
+
+    /// Sets the spring layer's displacements (a resumed run, as
+    /// [`Self::spring_displacements`] returned them).
+    ///
+    /// # Errors
+    /// Not one per dashpot, or not finite.
+    pub fn resume_spring_displacements(
+        &mut self,
+        displacements: Vec<SVector<f64, D>>,
+    ) -> Result<(), SolverError> {
+        if displacements.len() != self.spring_displacement.len()
+            || displacements
+                .iter()
+                .any(|u| !u.iter().all(|x| x.is_finite()))
+        {
+            return Err(SolverError::InvalidInput(format!(
+                "{} spring displacements for {} absorbing nodes; they must be one per node and finite",
+                displacements.len(),
+                self.spring_displacement.len()
+            )));
+        }
+        self.spring_displacement = displacements;
+        Ok(())
+    }
+
     /// Wall time per stage so far.
     pub fn stage_times(&self) -> &ExplicitStageTimes {
         &self.stage_times
@@ -515,6 +552,7 @@ where
             .map_err(|e| self.point_failure(&points.id, e));
         let walls = self.collective(updated)?;
         self.wall_work = self.wall_work.plus(self.sum_wall_work(walls)?);
+        self.share_spring_displacements()?;
         clock.time(Stage::Grid, || self.hold_over_ranks(points))?;
         let work = self.point_force_power(points);
         let gathered = clock
@@ -596,9 +634,14 @@ where
         dt: f64,
     ) -> Result<WallWork, (usize, PointFailure)> {
         let owner = self.on_ranks.as_ref().map(OnRanks::owner_of_node);
-        let work = grid_update::update(&self.buffers, &mut self.grid, dt, &self.fixities, |i| {
-            owner.is_none_or(|(me, owners)| owners.get(i) == Some(&me))
-        });
+        let work = grid_update::update(
+            &self.buffers,
+            &mut self.grid,
+            dt,
+            &self.fixities,
+            &mut self.spring_displacement,
+            |i| owner.is_none_or(|(me, owners)| owners.get(i) == Some(&me)),
+        );
         // On several ranks the stencils are rebuilt even when this rank
         // holds no point now (its held points may have migrated away).
         if !points.fixed_velocity.is_empty() || self.on_ranks.is_some() {
@@ -644,7 +687,13 @@ where
     /// A law without a stored energy.
     pub fn energies(&self, points: &PointsOf<D, B, L, T>) -> Result<Energies, SolverError> {
         let local = energy::energies(&self.law, &self.options.gravity, points, self.external_work)
-            .map(|e| e.with_wall_work(self.wall_work));
+            .map(|e| Energies {
+                spring_energy: absorbing::spring_energy(
+                    self.fixities.dashpots(),
+                    &self.spring_displacement,
+                ),
+                ..e.with_wall_work(self.wall_work)
+            });
         let Some(on) = &self.on_ranks else {
             return local;
         };

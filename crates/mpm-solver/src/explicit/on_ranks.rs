@@ -209,6 +209,32 @@ where
         })
     }
 
+    /// The spring layer's displacements as their nodes' owners advanced
+    /// them, on every rank: each rank gives those of the nodes it owns and
+    /// the ranks sum them (no-op on one rank or without springs).
+    pub(super) fn share_spring_displacements(&mut self) -> Result<(), SolverError> {
+        let Some(on) = self
+            .on_ranks
+            .as_ref()
+            .filter(|_| self.fixities.dashpots().iter().any(|d| d.has_springs()))
+        else {
+            return Ok(());
+        };
+        let (me, owners) = on.owner_of_node();
+        let mut flat: Vec<f64> = (self.fixities.dashpots().iter())
+            .zip(&self.spring_displacement)
+            .flat_map(|(d, u)| {
+                let mine = owners.get(d.node) == Some(&me);
+                u.iter().map(move |&x| if mine { x } else { 0.0 })
+            })
+            .collect();
+        on.ranks.all_reduce(&mut flat, Reduce::Sum)?;
+        for (u, chunk) in self.spring_displacement.iter_mut().zip(flat.chunks(D)) {
+            u.copy_from_slice(chunk);
+        }
+        Ok(())
+    }
+
     /// A local outcome decided over the ranks ([`ranks::agree`]).
     pub(super) fn collective<V>(&self, local: Result<V, SolverError>) -> Result<V, SolverError> {
         match &self.on_ranks {
