@@ -228,34 +228,43 @@ fn the_algorithmic_tangent_matches_finite_differences_in_every_regime() {
 
 #[test]
 fn both_formulations_tangents_match_finite_differences_in_every_regime() {
-    // ΔF = exp(ε) R with the trial strain of each regime: b^e_n = 1.
     for (name, law) in laws_to_check() {
         for (regime, values) in regime_cases() {
-            let r = Rotation3::from_euler_angles(-0.3, 0.4, 1.2).into_inner();
-            let v = rotated(values);
-            let delta_f = SymSpectral::new(&v).unwrap().exp() * r;
-            let f_n = Rotation3::from_euler_angles(0.2, 0.1, -0.5).into_inner()
-                * Matrix3::from_diagonal(&Vector3::new(1.05, 0.97, 1.0));
-            let state = MaterialState {
-                be: Matrix3::identity(),
-                history: MohrCoulombHistory::default(),
-            };
-            let pc = check_previously_converged(&law, &delta_f, &f_n, &state, STEP)
-                .unwrap()
-                .unwrap_or_else(|| panic!("{name} {regime:?}: the stencil changed regime"));
-            assert!(
-                pc <= TOLERANCE,
-                "{name} {regime:?}: previously converged error {pc:e}"
-            );
-            let ul = check_spatial(&law, &delta_f, &f_n, &state, STEP)
-                .unwrap()
-                .unwrap_or_else(|| panic!("{name} {regime:?}: the stencil changed regime"));
-            assert!(
-                ul.max() <= TOLERANCE,
-                "{name} {regime:?}: spatial errors {ul:?}"
-            );
+            check_both_formulations(&law, name, regime, values);
         }
     }
+}
+
+/// Both formulations' tangents of `law` against finite differences at
+/// ΔF = exp(ε) R with the trial strain `values` of `regime` (b^e_n = 1,
+/// a rotated and stretched F_n), each within [`TOLERANCE`].
+fn check_both_formulations(law: &MohrCoulomb, name: &str, regime: Regime, values: [f64; 3]) {
+    let r = Rotation3::from_euler_angles(-0.3, 0.4, 1.2).into_inner();
+    let delta_f = SymSpectral::new(&rotated(values)).unwrap().exp() * r;
+    let f_n = Rotation3::from_euler_angles(0.2, 0.1, -0.5).into_inner()
+        * Matrix3::from_diagonal(&Vector3::new(1.05, 0.97, 1.0));
+    let state = MaterialState {
+        be: Matrix3::identity(),
+        history: MohrCoulombHistory::default(),
+    };
+    let pc = check_previously_converged(law, &delta_f, &f_n, &state, STEP)
+        .unwrap()
+        .unwrap_or_else(|| panic!("{name} {regime:?}: the stencil changed regime"));
+    let ul = check_spatial(law, &delta_f, &f_n, &state, STEP)
+        .unwrap()
+        .unwrap_or_else(|| panic!("{name} {regime:?}: the stencil changed regime"));
+    println!(
+        "formulations {name} {regime:?} {values:?}: {pc:e} {:e}",
+        ul.max()
+    );
+    assert!(
+        pc <= TOLERANCE,
+        "{name} {regime:?}: previously converged error {pc:e}"
+    );
+    assert!(
+        ul.max() <= TOLERANCE,
+        "{name} {regime:?}: spatial errors {ul:?}"
+    );
 }
 
 #[test]
@@ -646,29 +655,7 @@ fn assert_constant_stress_at_the_apex(law: &MohrCoulomb, eps: &Matrix3<f64>) {
 fn both_formulations_tangents_match_finite_differences_on_the_cut_off() {
     for (name, law) in cut_laws() {
         for (regime, values) in tension_cases() {
-            let r = Rotation3::from_euler_angles(-0.3, 0.4, 1.2).into_inner();
-            let delta_f = SymSpectral::new(&rotated(values)).unwrap().exp() * r;
-            let f_n = Rotation3::from_euler_angles(0.2, 0.1, -0.5).into_inner()
-                * Matrix3::from_diagonal(&Vector3::new(1.05, 0.97, 1.0));
-            let state = MaterialState {
-                be: Matrix3::identity(),
-                history: MohrCoulombHistory::default(),
-            };
-            let pc = check_previously_converged(&law, &delta_f, &f_n, &state, STEP)
-                .unwrap()
-                .unwrap_or_else(|| panic!("{name} {regime:?}: the stencil changed regime"));
-            let ul = check_spatial(&law, &delta_f, &f_n, &state, STEP)
-                .unwrap()
-                .unwrap_or_else(|| panic!("{name} {regime:?}: the stencil changed regime"));
-            println!(
-                "formulations {name} {regime:?} {values:?}: {pc:e} {:e}",
-                ul.max()
-            );
-            assert!(
-                pc <= TOLERANCE,
-                "{name} {regime:?}: previously converged {pc:e}"
-            );
-            assert!(ul.max() <= TOLERANCE, "{name} {regime:?}: spatial {ul:?}");
+            check_both_formulations(&law, name, regime, values);
         }
     }
 }
