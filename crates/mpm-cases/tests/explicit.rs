@@ -371,8 +371,9 @@ fn the_cube_falls_freely_then_bounces_on_the_floor() {
 ///
 /// Measured (800 points, about 4650 steps each, 2.5 s for the three runs
 /// in release on 2 cores): 0.4905000 and 0.4055429 m/s (relative errors
-/// 6e-15 and 9e-8), stuck 1.0e-10 m/s; energy residuals −2.2e-5, +5.4e-6
-/// and −3.6e-3 of the work.
+/// 6e-15 and 9e-8), stuck below 5e-8 m/s; energy residuals −1.1e-5,
+/// +1.5e-5 and −3.5e-3 of the work (with the stick's tangential loss in
+/// `wall_work`; −2.2e-5, +5.4e-6 and −3.6e-3 before).
 #[test]
 fn a_block_slides_down_a_friction_incline_as_coulomb_says_and_sticks_beyond_tan_theta() {
     let (g, theta) = (9.81, 30f64.to_radians());

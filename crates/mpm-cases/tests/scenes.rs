@@ -1488,6 +1488,7 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/explicit_cube.toml"),
         include_str!("../../../scenes/explicit_collapse.toml"),
         include_str!("../../../scenes/sliding_block.toml"),
+        include_str!("../../../scenes/rolling_cylinder.toml"),
         include_str!("../../../scenes/explicit_absorbing_gravity.toml"),
         include_str!("../../../scenes/footing_mohr_coulomb.toml"),
         include_str!("../../../scenes/biaxial_drucker_prager.toml"),
