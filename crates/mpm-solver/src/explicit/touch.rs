@@ -159,7 +159,7 @@ fn mark_over<const D: usize>(
         let to = ((x[c] + reach - lattice.origin[c]) / h)
             .floor()
             .clamp(0.0, last);
-        if !(from <= to) {
+        if from.is_nan() || to.is_nan() || from > to {
             return;
         }
         // Both within [0, last]: exact small integers.
