@@ -493,9 +493,10 @@ fn centre_and_spin(problem: &Problem<2>, snap: &Snapshot) -> ([f64; 2], f64) {
 /// settles from gravity put on at once and tips off the flat its lattice
 /// of points has at the bottom.
 ///
-/// Measured (release, 2 cores): 3.2722 m/s² (+0.07 %), α R = 3.258
-/// m/s², energy residual −5.2e-3 (11304 points, 3048 steps, 11 s);
-/// slipping: see docs/src/theory/contact.md.
+/// Measured (release): 3.2722 m/s² (+0.07 %), α R = 3.258 m/s², energy
+/// residual −5.2e-3 (11304 points, 3048 steps); slipping 4.0553 m/s²
+/// (−0.00 %), α R = 1.248 m/s², residual −5.9e-3; 10 s of CPU for the
+/// two runs (16.6 s on 2 cores shared with other builds).
 #[test]
 fn a_cylinder_rolls_down_a_friction_incline_at_two_thirds_g_sin_theta_and_slips_below_tan_theta_over_three()
  {
