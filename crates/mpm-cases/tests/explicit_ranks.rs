@@ -475,6 +475,31 @@ fn friction_walls_on_ranks_book_their_work_once() {
     }
 }
 
+/// A gap-checked friction wall (the rolling cylinder's) is refused on
+/// several ranks, by every rank and before any step: each rank sees only
+/// its own points, so the marks of the touched nodes would differ on the
+/// nodes the ranks share.
+#[test]
+fn gap_checked_walls_are_refused_on_ranks() {
+    let short = [
+        "solver.end_time=0.001".to_owned(),
+        "mesh.cells=[60, 24]".to_owned(),
+    ];
+    let text = include_str!("../../../scenes/rolling_cylinder.toml");
+    let (scene, source) = scene::parse(text, "rolling_cylinder.toml", &short).unwrap();
+    let problem = Problem::<2>::build(&scene, &source, scene.solver.padding()).unwrap();
+    let errors = ThreadRanks::run(2, |ranks| {
+        let control = common::on_ranks(&problem, ranks, &RunControl::default());
+        scene::run_explicit(&problem, &control, |_| Ok(()))
+            .map(|out| out.steps)
+            .map_err(|e| e.to_string())
+    });
+    for e in errors {
+        let e = e.unwrap_err();
+        assert!(e.contains("run on one process only"), "{e}");
+    }
+}
+
 /// An absorbing floor (issue 44) under the collapsing column, its dashpots
 /// and tangential springs on nodes that several ranks share: each node's
 /// absorbed work is booked by its owner and summed over the ranks, each

@@ -818,6 +818,11 @@ fn malformed_scenes_are_refused_with_a_located_message() {
             "bad.toml:21:12: `friction` applies to kind = friction, not fixed",
         ),
         (
+            "kind = \"fixed\"",
+            "kind = \"fixed\"\ngap_check = true",
+            "bad.toml:20:8: `gap_check` applies to kind = friction, not fixed",
+        ),
+        (
             "steps = 2",
             "steps = 0",
             "bad.toml:27:9: solver `steps` must be at least 1, got 0",
@@ -1483,6 +1488,7 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/explicit_cube.toml"),
         include_str!("../../../scenes/explicit_collapse.toml"),
         include_str!("../../../scenes/sliding_block.toml"),
+        include_str!("../../../scenes/rolling_cylinder.toml"),
         include_str!("../../../scenes/explicit_absorbing_gravity.toml"),
         include_str!("../../../scenes/footing_mohr_coulomb.toml"),
         include_str!("../../../scenes/biaxial_drucker_prager.toml"),

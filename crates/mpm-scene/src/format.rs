@@ -524,6 +524,11 @@ pub struct BoundarySpec {
     /// (dimensionless; 0 is a slip wall that lets go).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<Spanned<f64>>,
+    /// For `friction` (explicit solver): `true` makes the wall act on a
+    /// node only where a point touches the wall over it (the gap check:
+    /// a rolling body); default `false`, wherever the node has mass.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gap_check: Option<Spanned<bool>>,
     /// For `absorbing` (explicit solver): the `[[material]]` whose
     /// density and P- and S-wave speeds give the dashpots ρ c_p and ρ c_s
     /// per unit area.

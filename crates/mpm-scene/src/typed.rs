@@ -412,6 +412,7 @@ impl BoundarySpec {
             curve: None,
             velocity: None,
             friction: None,
+            gap_check: None,
             material: None,
             spring: None,
         }

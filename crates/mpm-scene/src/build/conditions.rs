@@ -27,9 +27,9 @@ pub(super) struct Conditions<const D: usize> {
     /// at (0 for the held nodes of fixed, roller and zero-displacement
     /// conditions).
     pub(super) velocity_dofs: Vec<Option<f64>>,
-    /// The explicit solver's friction walls: (node, axis, upper face, μ),
-    /// sorted by node and face.
-    pub(super) walls: Vec<(usize, usize, bool, f64)>,
+    /// The explicit solver's friction walls: (node, axis, upper face, μ,
+    /// gap check), sorted by node and face.
+    pub(super) walls: Vec<(usize, usize, bool, f64, bool)>,
 }
 
 /// The conditions of `scene` (its boundaries, then its mesh motion) on
@@ -84,7 +84,7 @@ pub(super) fn conditions<const D: usize>(
         },
         velocity_dofs: held.velocity_dofs,
         walls: (held.walls.into_iter())
-            .map(|((node, axis, upper), mu)| (node, axis, upper, mu))
+            .map(|((node, axis, upper), (mu, gap))| (node, axis, upper, mu, gap))
             .collect(),
     })
 }
@@ -95,8 +95,8 @@ struct Held<'a, const D: usize> {
     dofs: Vec<Option<(f64, u16)>>,
     /// Per mesh dof: the explicit solver's velocity.
     velocity_dofs: Vec<Option<f64>>,
-    /// Friction walls by (node, axis, upper face): μ.
-    walls: BTreeMap<(usize, usize, bool), f64>,
+    /// Friction walls by (node, axis, upper face): μ and the gap check.
+    walls: BTreeMap<(usize, usize, bool), (f64, bool)>,
     /// Conditions on sets that follow a body.
     following: Vec<Following<D>>,
     /// Initial node positions.
@@ -120,6 +120,11 @@ impl<const D: usize> Held<'_, D> {
             ("velocity", spec.velocity.is_some(), BoundaryKind::Velocity),
             ("material", spec.material.is_some(), BoundaryKind::Absorbing),
             ("spring", spec.spring.is_some(), BoundaryKind::Absorbing),
+            (
+                "gap_check",
+                spec.gap_check.is_some(),
+                BoundaryKind::Friction,
+            ),
         ] {
             if present && kind != owner {
                 return Err(src.at(
@@ -316,8 +321,9 @@ impl<const D: usize> Held<'_, D> {
             ));
         }
         let (axis, upper) = self.face_of(spec)?;
+        let gap = spec.gap_check.as_ref().is_some_and(|g| *g.get_ref());
         for &v in nodes {
-            self.walls.insert((v, axis, upper), value);
+            self.walls.insert((v, axis, upper), (value, gap));
             self.dofs[v * D + axis] = None;
             self.velocity_dofs[v * D + axis] = None;
         }
@@ -545,5 +551,27 @@ end_time = 0.1
             walls,
             vec![(2, 0, true, 0.0), (5, 0, true, 0.0), (8, 0, true, 0.0)]
         );
+    }
+
+    /// `gap_check = true` makes the face's walls gap-checked; without it
+    /// they act wherever a node has mass.
+    #[test]
+    fn gap_check_marks_the_walls_of_its_face() {
+        for (key, expected) in [
+            ("", false),
+            ("gap_check = true\n", true),
+            ("gap_check = false\n", false),
+        ] {
+            let text = format!(
+                "[[boundary]]\nset = \"y_min\"\nkind = \"friction\"\nfriction = 0.3\n{key}"
+            );
+            let mut fixities = build(&text).explicit.expect("an explicit scene").fixities;
+            fixities.finish();
+            assert_eq!(fixities.walls().len(), 3);
+            assert!(
+                fixities.walls().iter().all(|w| w.gap_check == expected),
+                "{key}"
+            );
+        }
     }
 }

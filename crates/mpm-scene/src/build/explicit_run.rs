@@ -152,12 +152,12 @@ fn point_fixities<const D: usize>(
 
 impl<const D: usize> ExplicitRun<D> {
     /// The run's setup with the nodal velocities `velocity_dofs` (per mesh
-    /// dof), the friction walls `walls` ((node, axis, upper face, μ)), the
+    /// dof), the friction walls `walls` ((node, axis, upper face, μ, gap check)), the
     /// loads `loads` and the absorbing faces `absorbing`.
     pub(super) fn setup(
         self,
         velocity_dofs: &[Option<f64>],
-        walls: &[(usize, usize, bool, f64)],
+        walls: &[(usize, usize, bool, f64, bool)],
         loads: ExplicitLoads<D>,
         absorbing: &[AbsorbingFace],
     ) -> ExplicitSetup<D> {
@@ -176,8 +176,12 @@ impl<const D: usize> ExplicitRun<D> {
         for ((component, bits), nodes) in groups {
             fixities.prescribe(nodes, component, f64::from_bits(bits));
         }
-        for &(node, axis, upper, mu) in walls {
-            fixities.friction([node], axis, upper, mu);
+        for &(node, axis, upper, mu, gap) in walls {
+            if gap {
+                fixities.friction_gap_checked([node], axis, upper, mu);
+            } else {
+                fixities.friction([node], axis, upper, mu);
+            }
         }
         for face in absorbing {
             let nodes = face.nodes.iter().copied();

@@ -20,7 +20,7 @@ pub struct Energies {
     /// Energy dissipated by the friction walls since the start
     /// ([`super::WallWork::friction`]).
     pub friction_work: f64,
-    /// Energy lost in impacts on the friction walls since the start
+    /// Energy lost in impacts on the friction walls (and in stick) since the start
     /// ([`super::WallWork::impact`]).
     pub wall_work: f64,
     /// Energy absorbed by the absorbing boundaries since the start

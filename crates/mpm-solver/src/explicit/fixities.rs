@@ -47,6 +47,10 @@ pub struct FrictionWall {
     pub upper: bool,
     /// The Coulomb coefficient μ ≥ 0 (0: a slip wall that lets go).
     pub mu: f64,
+    /// Whether the wall acts only where a point touches it over the node
+    /// (the gap check, [`super::touch`]); otherwise wherever the node has
+    /// mass.
+    pub gap_check: bool,
     /// Bit `c`: component `c` is tangential and not held, so friction acts
     /// on it (set by [`VelocityFixities::finish`]).
     tangential: u8,
@@ -97,12 +101,37 @@ impl VelocityFixities {
         upper: bool,
         mu: f64,
     ) -> &mut Self {
+        self.add_walls(nodes, axis, upper, mu, false)
+    }
+
+    /// Friction walls as [`Self::friction`] that act on a node only where
+    /// a point touches the wall over it (the gap check,
+    /// [`super::touch::WallTouch`]).
+    pub fn friction_gap_checked(
+        &mut self,
+        nodes: impl IntoIterator<Item = usize>,
+        axis: usize,
+        upper: bool,
+        mu: f64,
+    ) -> &mut Self {
+        self.add_walls(nodes, axis, upper, mu, true)
+    }
+
+    fn add_walls(
+        &mut self,
+        nodes: impl IntoIterator<Item = usize>,
+        axis: usize,
+        upper: bool,
+        mu: f64,
+        gap_check: bool,
+    ) -> &mut Self {
         self.walls
             .extend(nodes.into_iter().map(|node| FrictionWall {
                 node,
                 axis,
                 upper,
                 mu,
+                gap_check,
                 tangential: 0,
             }));
         self

@@ -21,9 +21,11 @@ pub struct WallWork {
     /// times the tangential velocity it leaves,
     /// $m_i\,\|\mathbf v_t'\|\,(\|\mathbf v_t\| - \|\mathbf v_t'\|)$.
     pub friction: f64,
-    /// Lost in the impacts: per node the wall stops, the kinetic energy of
-    /// the normal velocity it brought to the step,
-    /// $\tfrac12 m_i(\mathbf v^n_i\cdot\mathbf n)^2$.
+    /// Lost in the impacts: per node the wall acts on, the kinetic energy
+    /// of the jump from the velocity it brought to the step to the one the
+    /// wall leaves, $\tfrac12 m_i\|\mathbf v'_i - \mathbf v^n_i\|^2$ —
+    /// the normal velocity stopped, and in stick the tangential one too
+    /// (docs/src/theory/contact.md, "Energy bookkeeping").
     pub impact: f64,
     /// Absorbed by the dashpots of the absorbing boundaries: per node
     /// and free component the dashpot's impulse times the velocity it
@@ -49,7 +51,8 @@ impl WallWork {
 /// no effect: no point reads it); then the friction walls
 /// ([`friction_walls`]) and the absorbing boundaries
 /// ([`absorbing::dashpots`]) with their springs' displacements `springs`
-/// (one per dashpot). Returns what the walls and dashpots took
+/// (one per dashpot); the gap-checked walls act where `touched` (one flag
+/// per node, [`super::touch::WallTouch`]). Returns what the walls and dashpots took
 /// from the nodes for which `counted` is true (on several ranks, those the
 /// rank owns).
 pub fn update<const D: usize>(
@@ -58,6 +61,7 @@ pub fn update<const D: usize>(
     dt: f64,
     fixities: &VelocityFixities,
     springs: &mut [SVector<f64, D>],
+    touched: &[bool],
     counted: impl Fn(usize) -> bool,
 ) -> WallWork {
     let lo = buffers.iter().map(|b| b.lo).min().unwrap_or(usize::MAX);
@@ -106,7 +110,7 @@ pub fn update<const D: usize>(
             grid.velocity[node].new[component] = value;
         }
     }
-    let walls = friction_walls(grid, fixities.walls(), &counted);
+    let walls = friction_walls(grid, fixities.walls(), touched, &counted);
     WallWork {
         absorbed: absorbing::dashpots(grid, fixities.dashpots(), springs, dt, &counted),
         ..walls
@@ -124,18 +128,27 @@ pub fn update<const D: usize>(
 /// normal one — but not past zero (stick):
 /// $\mathbf v_t' = \tilde{\mathbf v}_t\,\max(0, 1 - \mu\tilde v_n/\|\tilde{\mathbf v}_t\|)$.
 /// A node that moves away from its wall, or along it, is left free: the
-/// wall lets go. Walls follow one another in their order (a corner node
-/// of two walls meets both). Returns the [`WallWork`] of the nodes for
-/// which `counted` is true.
+/// wall lets go; so is a node of a gap-checked wall ([`FrictionWall::gap_check`])
+/// that no point touches (`touched[node]` false). Walls follow one
+/// another in their order (a corner node of two walls meets both, and
+/// its impact is booked once, from its velocity after both). Returns the
+/// [`WallWork`] of the nodes for which `counted` is true.
 pub fn friction_walls<const D: usize>(
     grid: &mut GridState<D>,
     walls: &[FrictionWall],
+    touched: &[bool],
     counted: impl Fn(usize) -> bool,
 ) -> WallWork {
     let mut work = WallWork::default();
+    // The last node whose impact was booked, and how much (walls are
+    // sorted by node, so a corner's walls follow one another).
+    let mut booked: Option<(usize, f64)> = None;
     for w in walls {
         let i = w.node;
         if !(i >= grid.lo && i < grid.hi && grid.mass[i] > 0.0) {
+            continue;
+        }
+        if w.gap_check && touched.get(i) != Some(&true) {
             continue;
         }
         let outward = if w.upper { 1.0 } else { -1.0 };
@@ -159,7 +172,10 @@ pub fn friction_walls<const D: usize>(
         if counted(i) {
             let m = grid.mass[i];
             work.friction += m * left * (speed - left);
-            work.impact += 0.5 * m * (outward * v.old[w.axis]).powi(2);
+            let impact = 0.5 * m * (v.new - v.old).norm_squared();
+            let before = booked.filter(|b| b.0 == i).map_or(0.0, |b| b.1);
+            work.impact += impact - before;
+            booked = Some((i, impact));
         }
     }
     work
@@ -272,30 +288,34 @@ mod tests {
         let mut walls = VelocityFixities::new();
         walls.friction([0], 2, false, mu);
         walls.finish();
-        let work = friction_walls(&mut grid, walls.walls(), |_| true);
+        let work = friction_walls(&mut grid, walls.walls(), &[], |_| true);
         (grid.velocity[0].new, work)
     }
 
     /// Sliding: the normal approach 0.5 goes, the tangential speed 5
     /// (along (3, 4)/5) drops by μ·0.5 = 0.1 in its own direction; the
-    /// friction work is m·|v_t'|·Δ|v_t|, the impact the old normal
-    /// velocity's energy.
+    /// friction work is m·|v_t'|·Δ|v_t|, the impact the energy of the jump
+    /// from the velocity the node brought, (2.9, 3.9, −0.25), to the one
+    /// left, (2.94, 3.92, 0).
     #[test]
     fn an_approaching_node_slides_with_coulomb_s_impulse() {
-        let (v, work) = on_floor([3.0, 4.0, -0.5], 0.2, [0.0, 0.0, -0.25]);
+        let (v, work) = on_floor([3.0, 4.0, -0.5], 0.2, [2.9, 3.9, -0.25]);
         let expected = SVector::<f64, 3>::new(3.0, 4.0, 0.0) * (4.9 / 5.0);
         assert!((v - expected).norm() < 1e-14, "{v}");
         assert!((work.friction - 2.0 * 4.9 * 0.1).abs() < 1e-14);
-        assert!((work.impact - 0.5 * 2.0 * 0.0625).abs() < 1e-15);
+        let jump = 0.04f64.powi(2) + 0.02f64.powi(2) + 0.25f64.powi(2);
+        assert!((work.impact - 0.5 * 2.0 * jump).abs() < 1e-15, "{work:?}");
     }
 
-    /// Stick: μ·v_n beyond the tangential speed stops the node, and
-    /// static friction does no work.
+    /// Stick: μ·v_n beyond the tangential speed stops the node; static
+    /// friction does no work, and the impact is the kinetic energy of the
+    /// whole velocity the node brought, tangential part included.
     #[test]
     fn a_node_sticks_when_coulomb_s_impulse_suffices() {
-        let (v, work) = on_floor([0.03, -0.04, -0.5], 0.2, [0.0; 3]);
+        let (v, work) = on_floor([0.03, -0.04, -0.5], 0.2, [0.03, -0.04, -0.1]);
         assert_eq!(v, SVector::<f64, 3>::zeros());
-        assert_eq!(work, WallWork::default());
+        assert_eq!(work.friction, 0.0);
+        assert!((work.impact - 0.5 * 2.0 * (0.0025 + 0.01)).abs() < 1e-15);
     }
 
     /// A node moving away from the wall (or along it) is left as it is,
@@ -307,9 +327,47 @@ mod tests {
             assert_eq!(after, SVector::from(v));
             assert_eq!(work, WallWork::default());
         }
-        let (after, work) = on_floor([1.0, 2.0, -0.5], 0.0, [0.0; 3]);
+        let (after, work) = on_floor([1.0, 2.0, -0.5], 0.0, [1.0, 2.0, 0.0]);
         assert_eq!(after, SVector::from([1.0, 2.0, 0.0]));
         assert_eq!(work, WallWork::default());
+    }
+
+    /// A corner node of two slip walls meets both and its impact is
+    /// booked once: ½ m |0 − v^n|² = ½·2·(0.25 + 1).
+    #[test]
+    fn a_corner_node_books_its_impact_once() {
+        let mut grid = GridState::<2>::new(1);
+        grid.mass[0] = 2.0;
+        grid.velocity[0] = NodeVelocity {
+            old: SVector::from([-0.5, -1.0]),
+            new: SVector::from([-1.0, -2.0]),
+        };
+        grid.hi = 1;
+        let mut walls = VelocityFixities::new();
+        walls
+            .friction([0], 0, false, 0.0)
+            .friction([0], 1, false, 0.0);
+        walls.finish();
+        let work = friction_walls(&mut grid, walls.walls(), &[], |_| true);
+        assert_eq!(grid.velocity[0].new, SVector::<f64, 2>::zeros());
+        assert!((work.impact - 1.25).abs() < 1e-15, "{work:?}");
+    }
+
+    /// A gap-checked wall acts only on the nodes marked touched.
+    #[test]
+    fn a_gap_checked_wall_acts_only_where_touched() {
+        for touched in [false, true] {
+            let mut grid = GridState::<2>::new(1);
+            grid.mass[0] = 1.0;
+            grid.velocity[0].new = SVector::from([1.0, -1.0]);
+            grid.hi = 1;
+            let mut walls = VelocityFixities::new();
+            walls.friction_gap_checked([0], 1, false, 0.5);
+            walls.finish();
+            friction_walls(&mut grid, walls.walls(), &[touched], |_| true);
+            let expected = if touched { [0.5, 0.0] } else { [1.0, -1.0] };
+            assert_eq!(grid.velocity[0].new, SVector::from(expected));
+        }
     }
 
     /// On the upper face of x in 2D (n = +e_x) with y held by a fixity:
@@ -325,7 +383,7 @@ mod tests {
         let mut walls = VelocityFixities::new();
         walls.friction([0], 0, true, 0.2).fix([0], 1);
         walls.finish();
-        let work = friction_walls(&mut grid, walls.walls(), |_| false);
+        let work = friction_walls(&mut grid, walls.walls(), &[], |_| false);
         assert_eq!(grid.velocity[0].new, SVector::from([0.0, 3.0]));
         assert_eq!(work, WallWork::default());
     }

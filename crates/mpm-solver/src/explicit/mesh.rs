@@ -3,6 +3,8 @@
 use mpm_mesh::RegularGrid;
 use nalgebra::SVector;
 
+use super::touch::Lattice;
+
 /// A background mesh for explicit MPM: node positions (the Taylor term of
 /// eq. 29), cells (the cell-averaged dilatation of eq. 53) and the length
 /// $h$ of the CFL condition (eq. 45).
@@ -17,6 +19,9 @@ pub trait ExplicitMesh<const D: usize>: Send + Sync {
     fn cell_of(&self, x: &SVector<f64, D>) -> Option<usize>;
     /// The smallest cell size, $h$ of eq. (45).
     fn min_spacing(&self) -> f64;
+    /// The regular lattice of the nodes (the gap check of the friction
+    /// walls finds the nodes under a point from it).
+    fn lattice(&self) -> Lattice<D>;
 }
 
 impl<const D: usize> ExplicitMesh<D> for RegularGrid<D> {
@@ -47,5 +52,13 @@ impl<const D: usize> ExplicitMesh<D> for RegularGrid<D> {
 
     fn min_spacing(&self) -> f64 {
         self.spacing().min()
+    }
+
+    fn lattice(&self) -> Lattice<D> {
+        Lattice {
+            origin: *self.origin(),
+            spacing: *self.spacing(),
+            nodes: self.nodes_per_axis(),
+        }
     }
 }

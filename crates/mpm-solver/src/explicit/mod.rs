@@ -43,6 +43,7 @@ pub mod options;
 pub mod p2g;
 pub mod points;
 pub mod tensor;
+pub mod touch;
 pub mod transfer;
 pub mod verification;
 
@@ -213,6 +214,8 @@ where
     /// The accumulated displacement of each absorbing node's spring
     /// layer, one per dashpot of `fixities` (the same on every rank).
     spring_displacement: Vec<SVector<f64, D>>,
+    /// The wall nodes the points touch (gap-checked walls only).
+    touch: touch::WallTouch<D>,
     stage_times: ExplicitStageTimes,
     fixed_start: Vec<f64>,
     /// The held points' (node, weight) pairs, and where each point's pairs end.
@@ -295,6 +298,7 @@ where
             Vec::new()
         };
         let spring_displacement = vec![SVector::zeros(); fixities.dashpots().len()];
+        let touch = touch::WallTouch::new(fixities.walls(), mesh.lattice());
         Ok(Self {
             basis,
             law,
@@ -320,6 +324,7 @@ where
             external_work: 0.0,
             wall_work: WallWork::default(),
             spring_displacement,
+            touch,
             stage_times: ExplicitStageTimes::default(),
             fixed_start: Vec::new(),
             held_stencils: (Vec::new(), Vec::new()),
@@ -370,6 +375,7 @@ where
             external_work: self.external_work,
             wall_work: self.wall_work,
             spring_displacement: self.spring_displacement,
+            touch: self.touch,
             stage_times: self.stage_times,
             fixed_start: self.fixed_start,
             held_stencils: self.held_stencils,
@@ -634,12 +640,14 @@ where
         dt: f64,
     ) -> Result<WallWork, (usize, PointFailure)> {
         let owner = self.on_ranks.as_ref().map(OnRanks::owner_of_node);
+        self.touch.mark(&points.position, &points.volume);
         let work = grid_update::update(
             &self.buffers,
             &mut self.grid,
             dt,
             &self.fixities,
             &mut self.spring_displacement,
+            self.touch.touched(),
             |i| owner.is_none_or(|(me, owners)| owners.get(i) == Some(&me)),
         );
         // On several ranks the stencils are rebuilt even when this rank

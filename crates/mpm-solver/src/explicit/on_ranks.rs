@@ -58,12 +58,20 @@ where
     /// communication.
     ///
     /// # Errors
-    /// A decomposition that does not fit the mesh or the ranks.
+    /// A decomposition that does not fit the mesh or the ranks; gap-checked
+    /// friction walls (each rank sees only its points).
     pub fn on_ranks(
         mut self,
         ranks: Box<dyn Ranks>,
         layout: Decomposition,
     ) -> Result<Self, SolverError> {
+        if self.touch.is_active() {
+            // Each rank sees only its own points: the marks would differ
+            // on the nodes the ranks share.
+            return Err(SolverError::InvalidInput(
+                "gap-checked friction walls (`gap_check = true`) run on one process only".into(),
+            ));
+        }
         layout.check(
             ranks.rank(),
             ranks.size(),
