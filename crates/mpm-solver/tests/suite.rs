@@ -14,3 +14,4 @@ mod locking;
 mod moving_mesh;
 mod ranks;
 mod stiffness;
+mod contact;
