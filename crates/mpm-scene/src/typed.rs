@@ -412,6 +412,10 @@ impl BoundarySpec {
             curve: None,
             velocity: None,
             friction: None,
+            normal: None,
+            rough: None,
+            normal_stiffness: None,
+            tangential_stiffness: None,
             material: None,
             spring: None,
         }

@@ -23,8 +23,9 @@
 //!   $|\mathbf t^{tr}| \le \mu f_n$, else slip
 //!   $\mathbf t = \mu f_n\,\mathbf s$, $\mathbf s = \mathbf t^{tr}/|\mathbf t^{tr}|$.
 //!
-//! The force on the body is $\mathbf F = f_n\mathbf n + \mathbf t$; the
-//! residual gains $-\mathbf F$ and the stiffness
+//! The force on the body is $\mathbf F = f_n\mathbf n + \mathbf t$, an
+//! external force of the node: the residual gains $-\mathbf F$ and the
+//! stiffness
 //! $K = -\partial\mathbf F/\partial\mathbf d$:
 //! stick $K = k_n\mathbf n\mathbf n^T + k_t P$; slip
 //! $K = k_n\mathbf n\mathbf n^T + \mu k_n\,\mathbf s\mathbf n^T

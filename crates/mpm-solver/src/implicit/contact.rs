@@ -43,9 +43,23 @@ pub(super) struct ContactState<const D: usize> {
     entries: Vec<Entry<D>>,
     /// Per entry, the response at the current increment.
     trial: Vec<ContactResponse<D>>,
+    /// Per entry, the points' external force at its node, to which the
+    /// tool's force is added ([`ContactState::keep_external`]).
+    base: Vec<SVector<f64, D>>,
 }
 
 impl<const D: usize> ContactState<D> {
+    /// Keeps the points' external force `f_ext` at the nodes in contact
+    /// (after the step's external force is assembled).
+    pub(super) fn keep_external(&mut self, f_ext: &[f64]) {
+        self.base.clear();
+        let base = self
+            .entries
+            .iter()
+            .map(|e| SVector::<f64, D>::from_fn(|i, _| f_ext[D * e.node + i]));
+        self.base.extend(base);
+    }
+
     /// Whether any node touches a tool this step.
     pub(super) fn is_empty(&self) -> bool {
         self.entries.is_empty()
@@ -71,6 +85,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         let state = &mut self.contact;
         state.entries.clear();
         state.trial.clear();
+        state.base.clear();
         if tools.is_empty() {
             return Ok(false);
         }
@@ -145,20 +160,24 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         Ok(unsymmetric)
     }
 
-    /// Adds $-\mathbf F$ of every node in contact at the current increment
-    /// to `f_int` and keeps the responses for the stiffness, the
-    /// reactions and the commit.
-    pub(super) fn add_contact_force(&mut self, f_int: &mut [f64]) {
+    /// Sets the external force at every node in contact to the points'
+    /// plus the tool's force $\mathbf F$ at the current increment, and
+    /// keeps the responses for the stiffness, the reactions and the
+    /// commit. The tool's force is external: the residual
+    /// $f^{int} - f^{ext}$ gains $-\mathbf F$, and the normalisation of
+    /// eq. (40) counts it with the external forces (a platen alone loads
+    /// a weightless body).
+    pub(super) fn add_contact_force(&mut self) {
         let state = &mut self.contact;
-        let du = &self.it.du;
+        let (du, f_ext) = (&self.it.du, &mut self.it.f_ext);
         state.trial.clear();
-        for e in &state.entries {
+        for (e, base) in state.entries.iter().zip(&state.base) {
             let v = e.node;
             let d = SVector::<f64, D>::from_fn(|i, _| du[D * v + i]) - e.tool_du;
             let r = e.law.respond(&state.committed[e.tool][e.index], &d);
             let f = r.force.vector(&e.law.normal);
             for i in 0..D {
-                f_int[D * v + i] -= f[i];
+                f_ext[D * v + i] = base[i] + f[i];
             }
             state.trial.push(r);
         }

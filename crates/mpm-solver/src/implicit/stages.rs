@@ -399,6 +399,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     pub fn assemble_external_force(&mut self, points: &PointsOf<D, P>, lambda1: f64) {
         gather::external_force(&self.system, points, lambda1, &mut self.it.f_ext);
         Self::sum_over_ranks(&mut self.ranks, &mut self.it.f_ext);
+        self.contact.keep_external(&self.it.f_ext);
     }
 
     /// Stage 4a with backtracking: when a Newton correction inverts a
@@ -646,7 +647,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             self.ghost.add_force::<D>(&self.it.du, &mut f_int);
         }
         if !self.contact.is_empty() {
-            self.add_contact_force(&mut f_int);
+            self.add_contact_force();
         }
         Self::sum_over_ranks(&mut self.ranks, &mut f_int);
         self.it.f_int = f_int;
@@ -888,7 +889,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             self.ghost.add_stiffness(&self.system, &mut values);
         }
         if !self.contact.is_empty() {
-            self.add_contact_force(&mut f_int);
+            self.add_contact_force();
             self.add_contact_stiffness(&mut values);
         }
         Self::sum_over_ranks(&mut self.ranks, &mut f_int);
