@@ -64,6 +64,13 @@ impl<const D: usize> ContactState<D> {
     pub(super) fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }
+
+    /// Whether a tool in contact moves over this step: its motion starts
+    /// the step as a prescribed increment does (the linearised start of
+    /// [`crate::FirstTangent::Converged`]).
+    pub(super) fn tools_move(&self) -> bool {
+        self.entries.iter().any(|e| e.tool_du.iter().any(|&u| u != 0.0))
+    }
 }
 
 impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {

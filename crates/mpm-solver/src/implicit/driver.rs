@@ -34,7 +34,8 @@ pub trait NewtonStages<const D: usize> {
     /// The secant predictor for the load increment `dlambda`; whether it
     /// set any increment.
     fn predict(&mut self, dlambda: f64) -> bool;
-    /// Whether the step starts with prescribed increments.
+    /// Whether the step starts with prescribed increments (or a moving
+    /// rigid tool).
     fn has_prescribed_increment(&self) -> bool;
     /// The first solve linearised about the converged state.
     fn linearised_start(&mut self) -> Result<(), StepFailure>;
@@ -318,7 +319,7 @@ impl<const D: usize, P: SolverParts<D>> NewtonStages<D> for Bound<'_, D, P> {
     }
 
     fn has_prescribed_increment(&self) -> bool {
-        self.solver.it.du.iter().any(|&u| u != 0.0)
+        self.solver.it.du.iter().any(|&u| u != 0.0) || self.solver.contact.tools_move()
     }
 
     fn linearised_start(&mut self) -> Result<(), StepFailure> {
