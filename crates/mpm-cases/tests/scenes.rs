@@ -2482,7 +2482,10 @@ fn a_rigid_footing_reproduces_the_prescribed_one_smooth_and_rough() {
         "footing at φ = 0: prescribed {q_p:.5} c ({it_p} iterations in {steps_p} steps), smooth tool {q_s:.5} c ({it_s} in {steps_s}), rough tool {q_r:.5} c ({it_r} in {steps_r})"
     );
     let prandtl = 2.0 + std::f64::consts::PI;
-    assert!((q_s - q_p).abs() <= 0.01 * q_p, "smooth tool {q_s} against {q_p}");
+    assert!(
+        (q_s - q_p).abs() <= 0.01 * q_p,
+        "smooth tool {q_s} against {q_p}"
+    );
     assert!(q_r >= q_s * (1.0 - 1e-3), "rough {q_r} below smooth {q_s}");
     for (q, what) in [(q_s, "smooth"), (q_r, "rough")] {
         assert!(q > prandtl && q < 1.1 * prandtl, "{what} tool {q}");
@@ -2498,7 +2501,11 @@ fn a_rigid_footing_reproduces_the_prescribed_one_smooth_and_rough() {
 /// 3 % of its mean across the points, and its mean within 3 % of
 /// E ln(0.99) (Hencky, uniaxial stress). The rough platen and base (pure
 /// stick) barrel the cube: its σ_zz spread is printed and must exceed the
-/// smooth one's.
+/// smooth one's. The platen's reaction is its force (E ln 0.99 on the
+/// quarter's 1 m² within the same 3 %), and a uniform pressure acts at
+/// the face's centre: its moment about (0.5, 0.5, 1) must be below 1 %
+/// of the force times the half-width (the nodes' share of the face is
+/// symmetric about the centre; the lateral expansion shifts it by ν ε).
 #[test]
 fn a_smooth_platen_leaves_the_cube_uniformly_stressed() {
     let text = include_str!("../../../scenes/platen_cube.toml");
@@ -2510,11 +2517,16 @@ fn a_smooth_platen_leaves_the_cube_uniformly_stressed() {
         let mean = szz.iter().sum::<f64>() / szz.len() as f64;
         let worst = szz.iter().map(|s| (s - mean).abs()).fold(0.0, f64::max);
         let iterations: usize = out.reports.iter().map(|r| r.iterations()).sum();
-        (mean, worst / mean.abs(), iterations)
+        let last = out.reports.last().unwrap();
+        let platen = &problem.reactions[0];
+        let force = platen.total(last);
+        let moment = platen.moment(&problem, last).unwrap();
+        println!("platen force {force:?}, moment {moment:?}");
+        (mean, worst / mean.abs(), iterations, force, moment)
     };
-    let (mean, smooth, it_s) = spread(text);
+    let (mean, smooth, it_s, force, moment) = spread(text);
     let rough_text = text.replace("friction = 0.0", "rough = true");
-    let (mean_r, rough, it_r) = spread(&rough_text);
+    let (mean_r, rough, it_r, _, _) = spread(&rough_text);
     let expected = 1.0e7 * 0.99f64.ln();
     println!(
         "platen: smooth σ_zz mean {mean:.1} Pa (E ln 0.99 = {expected:.1}), spread {:.3} % ({it_s} iterations); rough mean {mean_r:.1} Pa, spread {:.2} % ({it_r} iterations)",
@@ -2522,6 +2534,18 @@ fn a_smooth_platen_leaves_the_cube_uniformly_stressed() {
         100.0 * rough
     );
     assert!(smooth <= 0.03, "smooth platen: σ_zz spread {smooth}");
-    assert!((mean - expected).abs() <= 0.03 * expected.abs(), "mean σ_zz {mean}");
+    assert!(
+        (mean - expected).abs() <= 0.03 * expected.abs(),
+        "mean σ_zz {mean}"
+    );
     assert!(rough > smooth, "rough {rough} against smooth {smooth}");
+    assert!(
+        (force[2] - expected).abs() <= 0.03 * expected.abs(),
+        "{force:?}"
+    );
+    let lever = 0.01 * force[2].abs() * 0.5;
+    assert!(
+        moment[0].abs() <= lever && moment[1].abs() <= lever,
+        "{moment:?}"
+    );
 }

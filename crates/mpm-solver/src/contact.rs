@@ -268,7 +268,11 @@ mod tests {
                 continue;
             }
             let e = fd_error(&c, &f0, &d, 1e-7);
-            assert!(e < 1e-6, "D = {D}, {:?}, μ = {mu}: relative error {e:e}", r.regime);
+            assert!(
+                e < 1e-6,
+                "D = {D}, {:?}, μ = {mu}: relative error {e:e}",
+                r.regime
+            );
         }
         assert!(seen[1] > 20 && seen[2] > 20, "states per regime {seen:?}");
     }
@@ -300,7 +304,11 @@ mod tests {
                 let target = 0.4 * f0.normal * side;
                 let d = -dir * ((target - 0.1 * f0.normal) / c.k_t);
                 let r = c.respond(&t0, &d);
-                let expect = if side < 1.0 { Regime::Stick } else { Regime::Slip };
+                let expect = if side < 1.0 {
+                    Regime::Stick
+                } else {
+                    Regime::Slip
+                };
                 assert_eq!(r.regime, expect);
                 // A difference step well inside the margin 1e-4 of the
                 // cone (k_t h ≈ 2e-6 of a trial force 4e-5 from the cone)

@@ -60,7 +60,8 @@ fn body_with_tool<L: LogStrainLaw>(
             (j as f64 + 0.5 + jitter(1)) * h / 2.0,
         ));
     }
-    let points = MaterialPoints::new(pos, vec![(h / 2.0).powi(2); 36], 1000.0, vec![(); 36]).unwrap();
+    let points =
+        MaterialPoints::new(pos, vec![(h / 2.0).powi(2); 36], 1000.0, vec![(); 36]).unwrap();
     let mut nodal = NodalConstraints::<2>::new(grid.node_count());
     let mut top = Vec::new();
     for n in 0..grid.node_count() {
@@ -90,7 +91,15 @@ fn body_with_tool<L: LogStrainLaw>(
         weak_node_threshold: 0.0,
         ..NewtonOptions::default()
     };
-    let solver = ImplicitSolver::new(LinearMpm, grid, law, NoLocking, NoUpdate, constraints, options);
+    let solver = ImplicitSolver::new(
+        LinearMpm,
+        grid,
+        law,
+        NoLocking,
+        NoUpdate,
+        constraints,
+        options,
+    );
     (solver, points, top)
 }
 

@@ -16,8 +16,8 @@ use super::node_sets::NodeSets;
 use super::{Following, SceneConstraints, axes_of, face_name};
 use crate::SceneError;
 use crate::format::{Axes, BoundaryKind, BoundarySpec, Scene};
-use mpm_solver::RigidTool;
 use crate::source::SceneSource;
+use mpm_solver::RigidTool;
 use toml::Spanned;
 
 /// The Dirichlet conditions of a scene.
@@ -368,9 +368,13 @@ impl<const D: usize> Held<'_, D> {
             Some(n) => {
                 let a = axes_of::<D>(n, "normal", src)?;
                 let v = SVector::<f64, D>::from_fn(|i, _| a[i].unwrap_or(0.0));
-                if v.norm() == 0.0 {
+                // Scaled by its largest component first: no overflow or
+                // underflow of the norm for extreme components.
+                let largest = v.amax();
+                if largest == 0.0 {
                     return Err(src.at(n, "`normal` must not be zero"));
                 }
+                let v = v / largest;
                 v / v.norm()
             }
             None => {

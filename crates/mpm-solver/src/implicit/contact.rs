@@ -69,7 +69,9 @@ impl<const D: usize> ContactState<D> {
     /// the step as a prescribed increment does (the linearised start of
     /// [`crate::FirstTangent::Converged`]).
     pub(super) fn tools_move(&self) -> bool {
-        self.entries.iter().any(|e| e.tool_du.iter().any(|&u| u != 0.0))
+        self.entries
+            .iter()
+            .any(|e| e.tool_du.iter().any(|&u| u != 0.0))
     }
 }
 
