@@ -25,12 +25,11 @@
 //!
 //! The force on the body is $\mathbf F = f_n\mathbf n + \mathbf t$, an
 //! external force of the node: the residual gains $-\mathbf F$ and the
-//! stiffness
-//! $K = -\partial\mathbf F/\partial\mathbf d$:
-//! stick $K = k_n\mathbf n\mathbf n^T + k_t P$; slip
-//! $K = k_n\mathbf n\mathbf n^T + \mu k_n\,\mathbf s\mathbf n^T
-//! + \frac{\mu f_n k_t}{|\mathbf t^{tr}|}(I - \mathbf s\mathbf s^T)P$,
-//! not symmetric (the theory page derives both).
+//! stiffness $K = -\partial\mathbf F/\partial\mathbf d$: in stick
+//! $K = k_n\mathbf n\mathbf n^T + k_t P$, in slip
+//! $K = k_n\mathbf n\mathbf n^T + \mu k_n\,\mathbf s\mathbf n^T +
+//! \frac{\mu f_n k_t}{|\mathbf t^{tr}|}(I - \mathbf s\mathbf s^T)P$,
+//! which is not symmetric (the theory page derives both).
 
 use nalgebra::{SMatrix, SVector};
 

@@ -37,6 +37,10 @@ impl<const D: usize> Constraints<D> for WithTools<D> {
     }
 }
 
+/// The solver of these tests under law `L`.
+type Solver<L> =
+    ImplicitSolver<2, Parts<LinearMpm, PreviouslyConverged, L, NoLocking, NoUpdate, WithTools<2>>>;
+
 /// A 2D body of 6 × 6 jittered points on a 3 × 3 grid (h = 0.5), the
 /// base fixed, a tool with normal −y on the top nodes moving by `motion`
 /// over the step, friction `mu`.
@@ -44,11 +48,7 @@ fn body_with_tool<L: LogStrainLaw>(
     law: L,
     mu: f64,
     motion: SVector<f64, 2>,
-) -> (
-    ImplicitSolver<2, Parts<LinearMpm, PreviouslyConverged, L, NoLocking, NoUpdate, WithTools<2>>>,
-    MaterialPoints<2, L::History, ()>,
-    Vec<usize>,
-) {
+) -> (Solver<L>, MaterialPoints<2, L::History, ()>, Vec<usize>) {
     let h = 0.5;
     let grid = RegularGrid::new(SVector::zeros(), SVector::from_element(h), [3, 3]).unwrap();
     let mut pos = Vec::new();
