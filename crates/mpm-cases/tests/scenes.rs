@@ -2584,3 +2584,17 @@ fn a_slipping_platen_converges_quadratically_with_lu() {
     println!("μ = 0.05 platen: |F_t|/F_n = {ratio:.4}");
     assert!(ratio <= 0.05 && ratio > 0.0, "{ratio}");
 }
+
+/// A rigid tool's penalties scale with the cell size: `kind = "contact"`
+/// on a simplex mesh is refused at its `kind`.
+#[test]
+fn a_rigid_tool_on_a_simplex_mesh_is_refused() {
+    let text = VALID
+        .replace("cells = [2, 2]", "cells = [2, 2]\nkind = \"simplex\"")
+        .replace("kind = \"fixed\"", "kind = \"contact\"");
+    let e = refusal(&text);
+    assert!(
+        e.contains("bad.toml:21:8: kind = contact needs a regular grid"),
+        "{e}"
+    );
+}

@@ -58,6 +58,7 @@ pub(super) fn conditions<const D: usize>(
         velocity_dofs: vec![None; node_count * D],
         walls: BTreeMap::new(),
         tools: Vec::new(),
+        grid: matches!(mesh.mesh, super::SceneMesh::Grid(_)),
         following: Vec::new(),
         initial_nodes: (0..node_count)
             .map(|v| mesh.mesh.node_position(v))
@@ -107,6 +108,8 @@ struct Held<'a, const D: usize> {
     walls: BTreeMap<(usize, usize, bool), f64>,
     /// The rigid tools of `kind = "contact"`.
     tools: Vec<SceneTool<D>>,
+    /// The mesh is a regular grid (a tool's penalty needs its cell size).
+    grid: bool,
     /// Conditions on sets that follow a body.
     following: Vec<Following<D>>,
     /// Initial node positions.
@@ -362,6 +365,12 @@ impl<const D: usize> Held<'_, D> {
             return Err(src.at(
                 g,
                 "`gradient` applies to kind = displacement, not contact (a rigid tool moves by `displacement`)",
+            ));
+        }
+        if !self.grid {
+            return Err(src.at(
+                &spec.kind,
+                "kind = contact needs a regular grid (its penalties scale with the cell size); this mesh is not one",
             ));
         }
         let normal = match &spec.normal {
