@@ -111,6 +111,7 @@ const BASES: [(&str, Cost); 21] = [
     ("explicit_cube.toml", Cost::Build),
     ("sliding_block.toml", Cost::Run),
     ("rolling_cylinder.toml", Cost::Run),
+    ("platen_cube.toml", Cost::Run),
     ("explicit_absorbing_column.toml", Cost::Run),
     ("explicit_absorbing_gravity.toml", Cost::Run),
     ("cube_gmsh.toml", Cost::Run),

@@ -331,6 +331,12 @@ where
     // ranks: restored whole, then dealt as at the start.
     let (state, earlier_time) = match &control.resume {
         Some(c) => {
+            if let Some(tool) = solver.constraints.tools().first() {
+                return Err(SolverError::Contact {
+                    tool: tool.name.clone(),
+                    reason: "a checkpoint does not hold the tools' contact forces: a run with a rigid tool (kind = contact) cannot be resumed; run it again from the start",
+                });
+            }
             resume_points(c, &mut points)?;
             solver.set_predictor_state(c.predictor.clone())?;
             (c.state, c.wall_time_s)

@@ -469,6 +469,12 @@ pub enum BoundaryKind {
     /// impedances of `material` (explicit solver; refused by the implicit
     /// one).
     Absorbing,
+    /// A rigid flat tool (footing, platen, base) in frictional contact
+    /// with the set's nodes: a penalty normal force that lets go in
+    /// tension and Coulomb friction `friction` (or `rough = true`), the
+    /// tool moving by `displacement` along `curve` (implicit solver;
+    /// refused by the explicit one, whose wall is kind = friction).
+    Contact,
 }
 
 /// Per-axis values; axes not given are left alone.
@@ -529,6 +535,24 @@ pub struct BoundarySpec {
     /// a rolling body); default `false`, wherever the node has mass.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gap_check: Option<Spanned<bool>>,
+    /// For `contact`: the unit normal of the tool's face, pointing into
+    /// the body (normalised here). Default on a grid face: the face's
+    /// inward normal; needed on a `[[node_set]]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<Spanned<Axes>>,
+    /// For `contact`: a rough tool (pure stick: no slip whatever the
+    /// normal force), instead of `friction`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rough: Option<Spanned<bool>>,
+    /// For `contact`: the normal penalty per unit area (Pa/m, > 0).
+    /// Default: 100 × 2G/h (G: the largest shear modulus of the points,
+    /// h: the mean grid spacing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal_stiffness: Option<Spanned<f64>>,
+    /// For `contact`: the tangential penalty per unit area (Pa/m, > 0).
+    /// Default: `normal_stiffness`'s value.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tangential_stiffness: Option<Spanned<f64>>,
     /// For `absorbing` (explicit solver): the `[[material]]` whose
     /// density and P- and S-wave speeds give the dashpots ρ c_p and ρ c_s
     /// per unit area.

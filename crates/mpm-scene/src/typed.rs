@@ -413,6 +413,10 @@ impl BoundarySpec {
             velocity: None,
             friction: None,
             gap_check: None,
+            normal: None,
+            rough: None,
+            normal_stiffness: None,
+            tangential_stiffness: None,
             material: None,
             spring: None,
         }

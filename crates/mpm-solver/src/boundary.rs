@@ -3,6 +3,7 @@
 
 use nalgebra::SVector;
 
+use crate::contact::RigidTool;
 use crate::error::MeshMotionError;
 use crate::mesh::MovableMesh;
 
@@ -28,6 +29,19 @@ pub trait Constraints<const D: usize>: Send + Sync {
     /// mesh node `node` over the load step from load factor `lambda0` to
     /// `lambda1`, or `None` if the degree of freedom is free.
     fn prescribed(&self, node: usize, component: usize, lambda0: f64, lambda1: f64) -> Option<f64>;
+
+    /// The rigid tools whose nodes are in frictional contact with them
+    /// (implicit solver; [`crate::contact`]). The default: none.
+    fn tools(&self) -> &[RigidTool<D>] {
+        &[]
+    }
+
+    /// The displacement increment of tool `tool` (an index into
+    /// [`Constraints::tools`]) over the load step from `lambda0` to
+    /// `lambda1`. The default: at rest.
+    fn tool_increment(&self, _tool: usize, _lambda0: f64, _lambda1: f64) -> SVector<f64, D> {
+        SVector::zeros()
+    }
 
     /// Brings the background mesh to its position at load factor `lambda`
     /// (called at the start of every step attempt with the step's initial

@@ -207,6 +207,15 @@ pub enum SolverError {
     /// The ghost penalty cannot be applied to this solver's parts.
     #[error("ghost penalty: {0}")]
     Ghost(&'static str),
+    /// A rigid tool's contact cannot be applied as set up
+    /// ([`crate::contact::RigidTool`]).
+    #[error("contact with rigid tool `{tool}`: {reason}")]
+    Contact {
+        /// The tool's name.
+        tool: String,
+        /// What is wrong.
+        reason: &'static str,
+    },
     /// The locking treatment could not place the points in patches.
     #[error("locking treatment: {0}")]
     Locking(#[from] LockingError),

@@ -70,6 +70,7 @@
 
 pub mod boundary;
 pub mod checkpoint;
+pub mod contact;
 pub mod domain;
 pub mod error;
 pub mod explicit;
@@ -88,6 +89,7 @@ pub mod stepping;
 
 pub use boundary::{Constraints, NodalConstraints, StepView};
 pub use checkpoint::Flat;
+pub use contact::RigidTool;
 pub use domain::{
     AnyGimpRule, ConvectedCorners, CornerMidpoint, DeformationRule, DetF, DiagF, DisplacementField,
     DomainContext, DomainError, DomainUpdater, DomainVolume, GimpContext, GimpRule,

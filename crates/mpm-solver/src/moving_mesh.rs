@@ -269,6 +269,14 @@ impl<const D: usize, C: Constraints<D>, M: MeshMotion<D>> Constraints<D> for Mov
         self.inner.prescribed(node, component, lambda0, lambda1)
     }
 
+    fn tools(&self) -> &[crate::contact::RigidTool<D>] {
+        self.inner.tools()
+    }
+
+    fn tool_increment(&self, tool: usize, lambda0: f64, lambda1: f64) -> SVector<f64, D> {
+        self.inner.tool_increment(tool, lambda0, lambda1)
+    }
+
     fn move_mesh<Mesh: MovableMesh<D>>(
         &mut self,
         mesh: &mut Mesh,

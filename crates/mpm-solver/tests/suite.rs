@@ -7,6 +7,7 @@
 mod common;
 
 mod bspline_boundary;
+mod contact;
 mod domain_table2;
 mod explicit;
 mod implicit_ranks;

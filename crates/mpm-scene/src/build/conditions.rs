@@ -17,6 +17,7 @@ use super::{Following, SceneConstraints, axes_of, face_name};
 use crate::SceneError;
 use crate::format::{Axes, BoundaryKind, BoundarySpec, Scene};
 use crate::source::SceneSource;
+use mpm_solver::RigidTool;
 use toml::Spanned;
 
 /// The Dirichlet conditions of a scene.
@@ -31,6 +32,10 @@ pub(super) struct Conditions<const D: usize> {
     /// gap check), sorted by node and face.
     pub(super) walls: Vec<(usize, usize, bool, f64, bool)>,
 }
+
+/// A rigid tool of `kind = "contact"`, its motion where its curve is 1
+/// and the curve.
+type SceneTool<const D: usize> = (RigidTool<D>, SVector<f64, D>, u16);
 
 /// The conditions of `scene` (its boundaries, then its mesh motion) on
 /// `mesh`, with the node sets `sets` and the curves `curves`; `explicit`:
@@ -52,6 +57,8 @@ pub(super) fn conditions<const D: usize>(
         dofs: vec![None; node_count * D],
         velocity_dofs: vec![None; node_count * D],
         walls: BTreeMap::new(),
+        tools: Vec::new(),
+        grid: matches!(mesh.mesh, super::SceneMesh::Grid(_)),
         following: Vec::new(),
         initial_nodes: (0..node_count)
             .map(|v| mesh.mesh.node_position(v))
@@ -81,6 +88,8 @@ pub(super) fn conditions<const D: usize>(
             curves: curves.curves.clone(),
             following: held.following,
             motion,
+            tool_motion: held.tools.iter().map(|t| (t.1, t.2)).collect(),
+            tools: held.tools.into_iter().map(|t| t.0).collect(),
         },
         velocity_dofs: held.velocity_dofs,
         walls: (held.walls.into_iter())
@@ -97,6 +106,10 @@ struct Held<'a, const D: usize> {
     velocity_dofs: Vec<Option<f64>>,
     /// Friction walls by (node, axis, upper face): μ and the gap check.
     walls: BTreeMap<(usize, usize, bool), (f64, bool)>,
+    /// The rigid tools of `kind = "contact"`.
+    tools: Vec<SceneTool<D>>,
+    /// The mesh is a regular grid (a tool's penalty needs its cell size).
+    grid: bool,
     /// Conditions on sets that follow a body.
     following: Vec<Following<D>>,
     /// Initial node positions.
@@ -125,6 +138,18 @@ impl<const D: usize> Held<'_, D> {
                 spec.gap_check.is_some(),
                 BoundaryKind::Friction,
             ),
+            ("normal", spec.normal.is_some(), BoundaryKind::Contact),
+            ("rough", spec.rough.is_some(), BoundaryKind::Contact),
+            (
+                "normal_stiffness",
+                spec.normal_stiffness.is_some(),
+                BoundaryKind::Contact,
+            ),
+            (
+                "tangential_stiffness",
+                spec.tangential_stiffness.is_some(),
+                BoundaryKind::Contact,
+            ),
         ] {
             if present && kind != owner {
                 return Err(src.at(
@@ -140,12 +165,12 @@ impl<const D: usize> Held<'_, D> {
         if let Some(mu) = spec
             .friction
             .as_ref()
-            .filter(|_| kind != BoundaryKind::Friction)
+            .filter(|_| kind != BoundaryKind::Friction && kind != BoundaryKind::Contact)
         {
             return Err(src.at(
                 mu,
                 format!(
-                    "`friction` applies to kind = friction, not {}",
+                    "`friction` applies to kind = friction or contact, not {}",
                     boundary_kind_name(kind)
                 ),
             ));
@@ -153,7 +178,13 @@ impl<const D: usize> Held<'_, D> {
         if kind == BoundaryKind::Friction && !self.explicit {
             return Err(src.at(
                 &spec.kind,
-                "kind = friction needs the explicit solver; the implicit solver has no friction wall (a roller is its slip wall)",
+                "kind = friction needs the explicit solver; the implicit solver's frictional wall is kind = contact (a rigid tool)",
+            ));
+        }
+        if kind == BoundaryKind::Contact && self.explicit {
+            return Err(src.at(
+                &spec.kind,
+                "kind = contact (a rigid tool) needs the implicit solver; the explicit solver's frictional wall is kind = friction",
             ));
         }
         if self.explicit && self.sets.following.contains_key(spec.set.get_ref()) {
@@ -187,6 +218,7 @@ impl<const D: usize> Held<'_, D> {
                 "kind = velocity needs the explicit solver; the implicit solver prescribes displacements (kind = displacement)",
             )),
             BoundaryKind::Friction => self.friction(spec, nodes),
+            BoundaryKind::Contact => self.contact(spec, nodes),
             // Its dashpots are built by `absorbing.rs`; it holds nothing.
             BoundaryKind::Absorbing => Ok(()),
         }
@@ -233,7 +265,7 @@ impl<const D: usize> Held<'_, D> {
                     self.curves.index(&spec.curve, src)?,
                 )
             }
-            BoundaryKind::Roller | BoundaryKind::Friction => {
+            BoundaryKind::Roller | BoundaryKind::Friction | BoundaryKind::Contact => {
                 return Err(src.at(
                     &spec.set,
                     format!(
@@ -327,6 +359,111 @@ impl<const D: usize> Held<'_, D> {
             self.dofs[v * D + axis] = None;
             self.velocity_dofs[v * D + axis] = None;
         }
+        Ok(())
+    }
+
+    /// `kind = "contact"`: a rigid tool on the set's nodes, its normal
+    /// (the face's inward one by default), friction, penalties and motion
+    /// (`displacement` along `curve`, at rest without).
+    fn contact(&mut self, spec: &BoundarySpec, nodes: &[usize]) -> Result<(), SceneError> {
+        let src = self.src;
+        if let Some(g) = &spec.gradient {
+            return Err(src.at(
+                g,
+                "`gradient` applies to kind = displacement, not contact (a rigid tool moves by `displacement`)",
+            ));
+        }
+        if !self.grid {
+            return Err(src.at(
+                &spec.kind,
+                "kind = contact needs a regular grid (its penalties scale with the cell size); this mesh is not one",
+            ));
+        }
+        let normal = match &spec.normal {
+            Some(n) => {
+                let a = axes_of::<D>(n, "normal", src)?;
+                let v = SVector::<f64, D>::from_fn(|i, _| a[i].unwrap_or(0.0));
+                // Scaled by its largest component first: no overflow or
+                // underflow of the norm for extreme components.
+                let largest = v.amax();
+                if largest == 0.0 {
+                    return Err(src.at(n, "`normal` must not be zero"));
+                }
+                let v = v / largest;
+                v / v.norm()
+            }
+            None => {
+                let set = spec.set.get_ref();
+                let face = (0..D)
+                    .flat_map(|i| [(i, false), (i, true)])
+                    .find(|&(i, upper)| face_name(i, upper) == *set);
+                let Some((axis, upper)) = face else {
+                    return Err(src.at(
+                        &spec.set,
+                        format!(
+                            "a rigid tool on `{set}` needs `normal = {{ x = …, y = … }}`, its face's normal pointing into the body (a grid face gives its own: {})",
+                            self.sets.faces.join(", ")
+                        ),
+                    ));
+                };
+                let mut v = SVector::<f64, D>::zeros();
+                v[axis] = if upper { -1.0 } else { 1.0 };
+                v
+            }
+        };
+        let friction = match (&spec.friction, &spec.rough) {
+            (Some(mu), Some(r)) if *r.get_ref() => {
+                return Err(src.at(
+                    mu,
+                    "give `friction = μ` or `rough = true`, not both (rough is pure stick)",
+                ));
+            }
+            (Some(mu), _) => {
+                let value = *mu.get_ref();
+                if !(value.is_finite() && value >= 0.0) {
+                    return Err(src.at(
+                        mu,
+                        format!("`friction` is a Coulomb coefficient: finite and ≥ 0, got {value}"),
+                    ));
+                }
+                value
+            }
+            (None, Some(r)) if *r.get_ref() => f64::INFINITY,
+            _ => 0.0,
+        };
+        let stiffness = |k: &Option<Spanned<f64>>, key: &str| -> Result<Option<f64>, SceneError> {
+            match k {
+                Some(k) if !(k.get_ref().is_finite() && *k.get_ref() > 0.0) => Err(src.at(
+                    k,
+                    format!(
+                        "`{key}` is a penalty per unit area (Pa/m): finite and > 0, got {}",
+                        k.get_ref()
+                    ),
+                )),
+                Some(k) => Ok(Some(*k.get_ref())),
+                None => Ok(None),
+            }
+        };
+        let motion = match &spec.displacement {
+            Some(d) => {
+                let a = displacement_of::<D>(d, src)?;
+                SVector::<f64, D>::from_fn(|i, _| a[i].unwrap_or(0.0))
+            }
+            None => SVector::zeros(),
+        };
+        let curve = self.curves.index(&spec.curve, src)?;
+        let mut nodes = nodes.to_vec();
+        nodes.sort_unstable();
+        nodes.dedup();
+        let tool = RigidTool {
+            name: spec.set.get_ref().clone(),
+            nodes,
+            normal,
+            friction,
+            normal_stiffness: stiffness(&spec.normal_stiffness, "normal_stiffness")?,
+            tangential_stiffness: stiffness(&spec.tangential_stiffness, "tangential_stiffness")?,
+        };
+        self.tools.push((tool, motion, curve as u16));
         Ok(())
     }
 
@@ -447,6 +584,7 @@ fn boundary_kind_name(kind: BoundaryKind) -> &'static str {
         BoundaryKind::Velocity => "velocity",
         BoundaryKind::Friction => "friction",
         BoundaryKind::Absorbing => "absorbing",
+        BoundaryKind::Contact => "contact",
     }
 }
 
@@ -455,6 +593,7 @@ fn boundary_kind_name(kind: BoundaryKind) -> &'static str {
 fn wall_name(kind: BoundaryKind) -> &'static str {
     match kind {
         BoundaryKind::Friction => "a friction wall",
+        BoundaryKind::Contact => "a rigid tool",
         _ => "a roller",
     }
 }

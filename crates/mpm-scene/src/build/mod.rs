@@ -108,6 +108,10 @@ pub struct SceneConstraints<const D: usize> {
     curves: Vec<Curve>,
     following: Vec<Following<D>>,
     motion: Option<MovingMesh<D, Free, SceneMotion<D>>>,
+    /// The rigid tools of `kind = "contact"`.
+    tools: Vec<mpm_solver::RigidTool<D>>,
+    /// Per tool, its displacement where its curve is 1 and the curve.
+    tool_motion: Vec<(SVector<f64, D>, u16)>,
 }
 
 /// No conditions: what a mesh motion wraps in a scene (the scene's own
@@ -221,6 +225,20 @@ impl<const D: usize> Constraints<D> for SceneConstraints<D> {
         }
         let c = &self.curves[curve as usize];
         Some(u * (c.at(lambda1) - c.at(lambda0)))
+    }
+
+    fn tools(&self) -> &[mpm_solver::RigidTool<D>] {
+        &self.tools
+    }
+
+    fn tool_increment(&self, tool: usize, lambda0: f64, lambda1: f64) -> SVector<f64, D> {
+        match self.tool_motion.get(tool) {
+            Some((u, curve)) => {
+                let c = &self.curves[*curve as usize];
+                u * (c.at(lambda1) - c.at(lambda0))
+            }
+            None => SVector::zeros(),
+        }
     }
 }
 

@@ -34,7 +34,8 @@ pub trait NewtonStages<const D: usize> {
     /// The secant predictor for the load increment `dlambda`; whether it
     /// set any increment.
     fn predict(&mut self, dlambda: f64) -> bool;
-    /// Whether the step starts with prescribed increments.
+    /// Whether the step starts with prescribed increments (or a moving
+    /// rigid tool).
     fn has_prescribed_increment(&self) -> bool;
     /// The first solve linearised about the converged state.
     fn linearised_start(&mut self) -> Result<(), StepFailure>;
@@ -74,6 +75,9 @@ pub trait NewtonStages<const D: usize> {
     fn linear_iterations(&self) -> usize;
     /// Whether the last solve factorised afresh.
     fn factorisation(&self) -> Option<crate::linear::Factorisation>;
+    /// The force of the rigid tools on the body at each node in contact
+    /// (mesh id), at the current increment.
+    fn contact_forces(&self) -> Vec<(usize, nalgebra::SVector<f64, D>)>;
     /// Stage 5: the converged state, the mesh at `lambda1` and the
     /// predictor's memory of the load increment `dlambda`.
     fn commit(&mut self, lambda1: f64, dlambda: f64) -> Result<(), SolverError>;
@@ -175,10 +179,18 @@ pub fn solve_load_step<const D: usize>(
     k.set_first_iterate_converged(monitor.iteration() == 1);
     let (reaction, node_reactions) = {
         let (f_int, f_ext) = k.forces();
-        (
-            convergence::reaction(k.system(), f_int, f_ext),
-            convergence::node_reactions(k.system(), f_int, f_ext),
-        )
+        let mut reaction = convergence::reaction(k.system(), f_int, f_ext);
+        let mut node_reactions = convergence::node_reactions(k.system(), f_int, f_ext);
+        // A tool's force is a reaction too (the residual holds −F at its
+        // nodes' free dofs).
+        for (v, f) in k.contact_forces() {
+            reaction += f;
+            match node_reactions.binary_search_by_key(&v, |(u, _)| *u) {
+                Ok(at) => node_reactions[at].1 += f,
+                Err(at) => node_reactions.insert(at, (v, f)),
+            }
+        }
+        (reaction, node_reactions)
     };
     clock.time(Stage::Commit, || k.commit(lambda1, lambda1 - lambda0))?;
     Ok(StepReport {
@@ -307,7 +319,7 @@ impl<const D: usize, P: SolverParts<D>> NewtonStages<D> for Bound<'_, D, P> {
     }
 
     fn has_prescribed_increment(&self) -> bool {
-        self.solver.it.du.iter().any(|&u| u != 0.0)
+        self.solver.it.du.iter().any(|&u| u != 0.0) || self.solver.contact.tools_move()
     }
 
     fn linearised_start(&mut self) -> Result<(), StepFailure> {
@@ -377,6 +389,10 @@ impl<const D: usize, P: SolverParts<D>> NewtonStages<D> for Bound<'_, D, P> {
 
     fn rank_failure(&mut self) -> Option<SolverError> {
         self.solver.ranks.as_mut()?.take_failure()
+    }
+
+    fn contact_forces(&self) -> Vec<(usize, nalgebra::SVector<f64, D>)> {
+        self.solver.contact_forces()
     }
 
     fn commit(&mut self, lambda1: f64, dlambda: f64) -> Result<(), SolverError> {

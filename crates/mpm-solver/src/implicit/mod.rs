@@ -40,6 +40,7 @@
 //! benchmarks).
 
 pub mod builder;
+mod contact;
 pub mod driver;
 mod on_ranks;
 pub mod options;
@@ -151,6 +152,9 @@ pub struct ImplicitSolver<const D: usize, P: SolverParts<D>> {
     hints: Vec<usize>,
     /// The other ranks of a distributed run ([`Self::on_ranks`]).
     ranks: Option<on_ranks::RankLink>,
+    /// The nodes in contact with the rigid tools of the constraints
+    /// ([`crate::Constraints::tools`]) and their committed forces.
+    contact: contact::ContactState<D>,
 }
 
 impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
@@ -186,6 +190,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             first_iterate_converged: false,
             hints: Vec::new(),
             ranks: None,
+            contact: contact::ContactState::default(),
         }
     }
 

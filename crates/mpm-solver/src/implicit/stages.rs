@@ -230,6 +230,8 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         });
         sys.active_of_mesh = active_of_mesh;
         sys.build_slot_offsets();
+        let unsymmetric_contact = self.build_contacts(points, lambda0, lambda1)?;
+        let sys = &mut self.system;
         let n_dofs = D * sys.n_active();
         let it = &mut self.it;
         it.du.clear();
@@ -241,7 +243,9 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         it.values.clear();
         it.values.resize(sys.row_idx.len(), 0.0);
         it.stiffness_assembled = false;
-        let symmetric = self.law.symmetric_tangent() && !self.locking.couples_points();
+        // The slip tangent of a frictional tool is not symmetric: LU.
+        let symmetric =
+            self.law.symmetric_tangent() && !self.locking.couples_points() && !unsymmetric_contact;
         self.analysed = false;
         match &self.ranks {
             Some(link) if self.linear.solves_over_ranks() => {
@@ -395,6 +399,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
     pub fn assemble_external_force(&mut self, points: &PointsOf<D, P>, lambda1: f64) {
         gather::external_force(&self.system, points, lambda1, &mut self.it.f_ext);
         Self::sum_over_ranks(&mut self.ranks, &mut self.it.f_ext);
+        self.contact.keep_external(&self.it.f_ext);
     }
 
     /// Stage 4a with backtracking: when a Newton correction inverts a
@@ -641,6 +646,9 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         if !self.ghost.is_empty() {
             self.ghost.add_force::<D>(&self.it.du, &mut f_int);
         }
+        if !self.contact.is_empty() {
+            self.add_contact_force();
+        }
         Self::sum_over_ranks(&mut self.ranks, &mut f_int);
         self.it.f_int = f_int;
     }
@@ -848,6 +856,9 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         if !self.ghost.is_empty() {
             self.ghost.add_stiffness(&self.system, &mut values);
         }
+        if !self.contact.is_empty() {
+            self.add_contact_stiffness(&mut values);
+        }
         self.sum_stiffness_over_ranks(&mut values);
         self.it.values = values;
         self.it.stiffness_assembled = true;
@@ -876,6 +887,10 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         if !self.ghost.is_empty() {
             self.ghost.add_force::<D>(&self.it.du, &mut f_int);
             self.ghost.add_stiffness(&self.system, &mut values);
+        }
+        if !self.contact.is_empty() {
+            self.add_contact_force();
+            self.add_contact_stiffness(&mut values);
         }
         Self::sum_over_ranks(&mut self.ranks, &mut f_int);
         self.sum_stiffness_over_ranks(&mut values);
@@ -931,7 +946,9 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
             &self.it.responses,
             points,
         );
-        self.agree(local)
+        self.agree(local)?;
+        self.commit_contacts();
+        Ok(())
     }
 
     /// The view [`Constraints::begin_step`] receives.
