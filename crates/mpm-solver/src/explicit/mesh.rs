@@ -17,6 +17,11 @@ pub trait ExplicitMesh<const D: usize>: Send + Sync {
     fn cell_of(&self, x: &SVector<f64, D>) -> Option<usize>;
     /// The smallest cell size, $h$ of eq. (45).
     fn min_spacing(&self) -> f64;
+    /// The volume of a cell (area in 2D; the contact's full node,
+    /// [`super::contact`]): $h^D$ unless the mesh says otherwise.
+    fn cell_volume(&self) -> f64 {
+        self.min_spacing().powi(D as i32)
+    }
 }
 
 impl<const D: usize> ExplicitMesh<D> for RegularGrid<D> {
@@ -47,5 +52,9 @@ impl<const D: usize> ExplicitMesh<D> for RegularGrid<D> {
 
     fn min_spacing(&self) -> f64 {
         self.spacing().min()
+    }
+
+    fn cell_volume(&self) -> f64 {
+        self.spacing().product()
     }
 }

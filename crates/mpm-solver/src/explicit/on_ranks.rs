@@ -64,6 +64,11 @@ where
         ranks: Box<dyn Ranks>,
         layout: Decomposition,
     ) -> Result<Self, SolverError> {
+        if self.contact.is_some() {
+            return Err(SolverError::InvalidInput(
+                "contact between bodies is not yet supported on several ranks".into(),
+            ));
+        }
         layout.check(
             ranks.rank(),
             ranks.size(),
