@@ -97,7 +97,7 @@ enum Cost {
 }
 
 /// The base scenes (in `scenes/`).
-const BASES: [(&str, Cost); 20] = [
+const BASES: [(&str, Cost); 21] = [
     ("features.toml", Cost::Run),
     ("two_layer_column.toml", Cost::Run),
     ("coombs2020_column.toml", Cost::Run),
@@ -110,6 +110,7 @@ const BASES: [(&str, Cost); 20] = [
     ("explicit_disks.toml", Cost::Run),
     ("explicit_cube.toml", Cost::Build),
     ("sliding_block.toml", Cost::Run),
+    ("sliding_block_contact.toml", Cost::Run),
     ("explicit_absorbing_column.toml", Cost::Run),
     ("explicit_absorbing_gravity.toml", Cost::Run),
     ("cube_gmsh.toml", Cost::Run),
