@@ -547,10 +547,58 @@ mod tests {
 
     #[test]
     fn bad_contact_is_refused() {
-        assert!(Contact::<2>::new(vec![0.1], 4).is_err());
-        assert!(Contact::<2>::new(vec![0.1, -0.1], 4).is_err());
-        assert!(Contact::<2>::new(vec![0.1, f64::NAN], 4).is_err());
-        assert!(Contact::<2>::new(vec![0.0; 257], 4).is_err());
-        assert_eq!(Contact::<2>::new(vec![0.1, 0.0], 4).unwrap().fields(), 2);
+        assert!(Contact::<2>::new(vec![0.1], 4, 1.0).is_err());
+        assert!(Contact::<2>::new(vec![0.1, -0.1], 4, 1.0).is_err());
+        assert!(Contact::<2>::new(vec![0.1, f64::NAN], 4, 1.0).is_err());
+        assert!(Contact::<2>::new(vec![0.0; 257], 4, 1.0).is_err());
+        assert!(Contact::<2>::new(vec![0.1, 0.0], 4, 0.0).is_err());
+        assert_eq!(
+            Contact::<2>::new(vec![0.1, 0.0], 4, 1.0)
+                .expect("valid")
+                .fields(),
+            2
+        );
+    }
+
+    /// The grid update of two fields meeting head-on at one node of a
+    /// grid of unit cells: they meet (equal velocities after, momentum
+    /// kept, the centre-of-mass grid holding the sum) when their volumes
+    /// fill the node to [`FILLED`], and pass each other untouched just
+    /// below it.
+    #[test]
+    fn fields_meet_only_at_filled_nodes() {
+        for (volume, meet) in [(0.5, true), (0.49, false)] {
+            let mut contact = Contact::<2>::new(vec![0.0, 0.0], 1, 1.0).expect("valid");
+            let mut buffer = FieldBuffer::<2>::new(1, 2);
+            // Field 0 on the left (its mass gradient points right, out of
+            // it), moving right; field 1 on the right moving left.
+            for (k, (v, g)) in [(1.0, 1.0), (-1.0, -1.0)].into_iter().enumerate() {
+                let s = &mut buffer.sums[k];
+                s.sums.mass = 1.0 + k as f64;
+                s.sums.momentum = Vector2::new(v, 0.0) * s.sums.mass;
+                s.mass_gradient = Vector2::new(g, 0.0);
+                s.volume = volume * FILLED;
+            }
+            (buffer.lo, buffer.hi) = (0, 1);
+            contact.buffers = vec![buffer];
+            let mut grid = GridState::<2>::new(1);
+            let mut fixities = VelocityFixities::new();
+            fixities.finish();
+            let work = update_fields(&mut contact, &mut grid, 0.1, &fixities);
+            let (a, b) = (
+                contact.grids[0].velocity[0].new,
+                contact.grids[1].velocity[0].new,
+            );
+            assert_eq!(grid.mass[0], 3.0);
+            assert!((grid.velocity[0].new.x - (1.0 - 2.0) / 3.0).abs() < 1e-15);
+            if meet {
+                assert!((a - b).norm() < 1e-15, "{a} {b}");
+                assert!((a.x + 2.0 * b.x - (1.0 - 2.0)).abs() < 1e-15);
+                assert!(work.impact > 0.0);
+            } else {
+                assert_eq!((a.x, b.x), (1.0, -1.0));
+                assert_eq!(work, WallWork::default());
+            }
+        }
     }
 }
