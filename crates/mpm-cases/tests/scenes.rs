@@ -1460,7 +1460,8 @@ fn features_scene_runs_with_every_remaining_key() {
 
 /// The `[[contact]]` tables, each mistake refused where it is: an
 /// implicit scene, a body that does not exist, a body twice, no body, a
-/// negative friction, a material-point fixity beside contact.
+/// negative friction, a material-point fixity or an absorbing boundary
+/// beside contact.
 #[test]
 fn contact_tables_are_checked() {
     let explicit = VALID.replacen("steps = 2", "kind = \"explicit\"\nend_time = 0.1", 1);
@@ -1497,6 +1498,14 @@ fn contact_tables_are_checked() {
                 "bodies = [\"b\"]\n\n[[point_fixity]]\nregion = { box = { lower = [0.0, 0.0], upper = [2.0, 0.5] } }\nvelocity = { x = 0.0 }",
             ),
             "bad.toml:31:10: [[contact]] is not supported with material-point fixities",
+        ),
+        (
+            contact("bodies = [\"b\"]").replacen(
+                "kind = \"fixed\"",
+                "kind = \"absorbing\"\nmaterial = \"m\"",
+                1,
+            ),
+            "bad.toml:32:10: [[contact]] is not supported with absorbing boundaries",
         ),
     ];
     for (text, expected) in cases {
