@@ -97,7 +97,7 @@ enum Cost {
 }
 
 /// The base scenes (in `scenes/`).
-const BASES: [(&str, Cost); 21] = [
+const BASES: [(&str, Cost); 23] = [
     ("features.toml", Cost::Run),
     ("two_layer_column.toml", Cost::Run),
     ("coombs2020_column.toml", Cost::Run),
@@ -112,6 +112,7 @@ const BASES: [(&str, Cost); 21] = [
     ("sliding_block.toml", Cost::Run),
     ("rolling_cylinder.toml", Cost::Run),
     ("platen_cube.toml", Cost::Run),
+    ("sliding_block_contact.toml", Cost::Run),
     ("explicit_absorbing_column.toml", Cost::Run),
     ("explicit_absorbing_gravity.toml", Cost::Run),
     ("cube_gmsh.toml", Cost::Run),

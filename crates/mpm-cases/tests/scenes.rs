@@ -1493,6 +1493,73 @@ fn features_scene_runs_with_every_remaining_key() {
     assert_eq!(reactions.lines().count(), 1 + out.reports.len());
 }
 
+/// The `[[contact]]` tables, each mistake refused where it is: an
+/// implicit scene, a body that does not exist, a body twice, no body, a
+/// negative friction, a material-point fixity or an absorbing boundary
+/// beside contact.
+#[test]
+fn contact_tables_are_checked() {
+    let explicit = VALID.replacen("steps = 2", "kind = \"explicit\"\nend_time = 0.1", 1);
+    let contact = |table: &str| {
+        explicit.replacen(
+            "end_time = 0.1",
+            &format!("end_time = 0.1\n\n[[contact]]\n{table}"),
+            1,
+        )
+    };
+    let cases = [
+        (
+            VALID.replacen("steps = 2", "steps = 2\n\n[[contact]]\nbodies = [\"b\"]", 1),
+            "bad.toml:30:10: [[contact]] is a condition of the explicit solver",
+        ),
+        (
+            contact("bodies = [\"nope\"]"),
+            "bad.toml:31:11: no body named `nope`; the scene has: b",
+        ),
+        (
+            contact("bodies = [\"b\", \"b\"]"),
+            "bad.toml:31:16: body `b` is already in a contact: a body has one velocity field",
+        ),
+        (
+            contact("bodies = []"),
+            "bad.toml:31:10: contact `bodies` names no body",
+        ),
+        (
+            contact("bodies = [\"b\"]\nfriction = -0.2"),
+            "bad.toml:32:12: contact `friction` -0.2 must be finite and non-negative",
+        ),
+        (
+            contact(
+                "bodies = [\"b\"]\n\n[[point_fixity]]\nregion = { box = { lower = [0.0, 0.0], upper = [2.0, 0.5] } }\nvelocity = { x = 0.0 }",
+            ),
+            "bad.toml:31:10: [[contact]] is not supported with material-point fixities",
+        ),
+        (
+            contact("bodies = [\"b\"]").replacen(
+                "kind = \"fixed\"",
+                "kind = \"absorbing\"\nmaterial = \"m\"",
+                1,
+            ),
+            "bad.toml:32:10: [[contact]] is not supported with absorbing boundaries",
+        ),
+    ];
+    for (text, expected) in cases {
+        let message = refusal(&text);
+        assert!(
+            message.contains(expected),
+            "expected: {expected}\n     got: {message}"
+        );
+    }
+    // A valid table: the block alone in field 1 with μ = 0.3 (field 0,
+    // the default one, is empty).
+    let text = contact("bodies = [\"b\"]\nfriction = 0.3");
+    let (scene, src) = scene::parse(&text, "scene.toml", &[]).unwrap();
+    let problem = Problem::<2>::build(&scene, &src, scene.solver.padding()).unwrap();
+    let setup = problem.explicit.as_ref().unwrap().contact.as_ref().unwrap();
+    assert_eq!(setup.friction, [0.0, 0.3]);
+    assert!(!setup.field.is_empty() && setup.field.iter().all(|&k| k == 1));
+}
+
 /// Every key the guide page documents appears in a scene that a test of
 /// this file runs.
 #[test]
@@ -1519,6 +1586,7 @@ fn every_documented_key_is_exercised() {
         include_str!("../../../scenes/explicit_collapse.toml"),
         include_str!("../../../scenes/sliding_block.toml"),
         include_str!("../../../scenes/rolling_cylinder.toml"),
+        include_str!("../../../scenes/sliding_block_contact.toml"),
         include_str!("../../../scenes/explicit_absorbing_gravity.toml"),
         include_str!("../../../scenes/footing_mohr_coulomb.toml"),
         include_str!("../../../scenes/footing_rigid.toml"),

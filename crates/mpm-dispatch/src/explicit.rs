@@ -375,6 +375,16 @@ impl<const D: usize> Run<'_, '_, D> {
         )?
         .with_domain_update(rule);
         let mut points = initial_points::<D, B, L, T>(self.problem, setup)?;
+        if let Some(contact) = &setup.contact {
+            if let Some(run) = &self.control.ranks {
+                return Err(SolverError::InvalidInput(format!(
+                    "contact between bodies ([[contact]]) is not yet supported on {} ranks; run it on one",
+                    run.ranks.size()
+                )));
+            }
+            points.field.clone_from(&contact.field);
+            solver = solver.with_contact(contact.friction.clone())?;
+        }
         let reach = B::SUPPORT_RADIUS.ceil() as usize;
         let spread = (self.control.ranks.as_ref())
             .map(|run| Spread::new(run, grid, reach))

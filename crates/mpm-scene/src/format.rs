@@ -44,6 +44,9 @@ pub struct Scene {
         skip_serializing_if = "Vec::is_empty"
     )]
     pub point_fixities: Vec<PointFixitySpec>,
+    /// Multi-field contact between bodies (explicit solver).
+    #[serde(rename = "contact", default, skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<ContactSpec>,
     /// Load curves, referred to by name from loads and boundaries.
     #[serde(rename = "curve", default, skip_serializing_if = "Vec::is_empty")]
     pub curves: Vec<CurveSpec>,
@@ -594,6 +597,20 @@ pub struct PointFixitySpec {
     pub body: Option<Spanned<String>>,
     /// The held components and their velocities (m/s).
     pub velocity: Spanned<Axes>,
+}
+
+/// `[[contact]]`: the bodies named get a velocity field each on the
+/// shared grid and meet every other field by the multi-field contact of
+/// Bardenhagen et al. (2000, 2001) with Coulomb friction `friction`
+/// (explicit solver).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// The bodies, by name; each in one contact at most.
+    pub bodies: Spanned<Vec<Spanned<String>>>,
+    /// The Coulomb coefficient μ ≥ 0 (default 0: frictionless).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<Spanned<f64>>,
 }
 
 /// Kinds of load.

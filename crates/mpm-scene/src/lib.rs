@@ -26,7 +26,8 @@ pub mod typed;
 pub mod variant;
 
 pub use build::{
-    ExplicitSetup, Problem, ReactionOutput, SceneConstraints, SceneMotion, TimedForces,
+    ContactSetup, ExplicitSetup, Problem, ReactionOutput, SceneConstraints, SceneMotion,
+    TimedForces,
 };
 pub use error::SceneError;
 pub use format::Scene;

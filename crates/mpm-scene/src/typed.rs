@@ -85,6 +85,7 @@ impl Scene {
             boundaries: Vec::new(),
             loads: Vec::new(),
             point_fixities: Vec::new(),
+            contacts: Vec::new(),
             curves: Vec::new(),
             solver: SolverSpec::default(),
             output: OutputSpec::default(),

@@ -153,13 +153,15 @@ fn point_fixities<const D: usize>(
 impl<const D: usize> ExplicitRun<D> {
     /// The run's setup with the nodal velocities `velocity_dofs` (per mesh
     /// dof), the friction walls `walls` ((node, axis, upper face, μ, gap check)), the
-    /// loads `loads` and the absorbing faces `absorbing`.
+    /// loads `loads`, the absorbing faces `absorbing` and the contact
+    /// between bodies `contact`.
     pub(super) fn setup(
         self,
         velocity_dofs: &[Option<f64>],
         walls: &[(usize, usize, bool, f64, bool)],
         loads: ExplicitLoads<D>,
         absorbing: &[AbsorbingFace],
+        contact: Option<super::ContactSetup>,
     ) -> ExplicitSetup<D> {
         let k = self.keys;
         // One call per component and value (each call sorts the list).
@@ -207,6 +209,7 @@ impl<const D: usize> ExplicitRun<D> {
             point_fixities: self.point_fixities,
             rebalance_every: k.rebalance_every,
             rebalance_threshold: k.rebalance_threshold,
+            contact,
         }
     }
 }

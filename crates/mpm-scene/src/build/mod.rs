@@ -19,6 +19,7 @@ mod absorbing;
 mod bodies;
 mod cam_clay;
 mod conditions;
+mod contact;
 mod curves;
 mod explicit_keys;
 mod explicit_run;
@@ -50,6 +51,7 @@ use crate::variant::{LockingKind, Variant};
 use crate::format::{Axes, Field, Scene, TransferKind};
 
 pub use absorbing::AbsorbingFace;
+pub use contact::ContactSetup;
 pub use explicit_keys::{DEFAULT_CFL, DEFAULT_OUTPUTS};
 pub use loads::MANUFACTURED_FIELDS;
 pub use motion::SceneMotion;
@@ -350,6 +352,9 @@ pub struct ExplicitSetup<const D: usize> {
     /// On several processes: the imbalance past which the cells are dealt
     /// anew.
     pub rebalance_threshold: f64,
+    /// Multi-field contact between bodies, from `[[contact]]` (`None`:
+    /// one velocity field).
+    pub contact: Option<ContactSetup>,
 }
 
 /// Point forces of one explicit load with a curve: at simulated time t
@@ -692,6 +697,7 @@ impl<const D: usize> Problem<D> {
         )?;
         let strength_reduction =
             strength_reduction::strength_reduction(scene, &probes, explicit, src)?;
+        let contact = contact::contact(scene, explicit, !absorbing.is_empty(), &bodies, src)?;
         let explicit =
             explicit_run::explicit_run(explicit_keys, scene, &mesh, &materials, &bodies, src)?.map(
                 |run| {
@@ -700,6 +706,7 @@ impl<const D: usize> Problem<D> {
                         &conditions.walls,
                         loads.explicit,
                         &absorbing,
+                        contact,
                     )
                 },
             );

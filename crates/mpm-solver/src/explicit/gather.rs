@@ -97,6 +97,8 @@ where
         let per = task_size(points.len());
         let tasks = points.len().div_ceil(per);
         let (basis, mesh, grid, law) = (&self.basis, &self.mesh, &self.grid, &self.law);
+        // With contact each point reads its own field's grid.
+        let fields = self.contact.as_ref().map(|c| &c.grids[..]);
         let (rule, fixities) = (&self.domain_rule, &self.fixities);
         let (sums, starts) = (&self.cell_sums, &self.position_scratch);
         let alpha = self.transfer.alpha();
@@ -121,6 +123,7 @@ where
             kept,
         );
         let (mass, volume0, domain0) = (&p.mass[..], &p.volume0[..], &p.domain0[..]);
+        let field_of = &p.field[..];
         par::reduce(
             data,
             1,
@@ -145,12 +148,16 @@ where
                             let (grad, start) = if pass == Pass::Deform {
                                 (grads[k], *starts.get(point).unwrap_or(&x[k]))
                             } else {
+                                let own = match fields {
+                                    Some(f) => &f[usize::from(field_of[point])],
+                                    None => grid,
+                                };
                                 let g = g2p::interpolate(
                                     basis,
                                     mesh,
                                     &x[k],
                                     &dom[k],
-                                    grid,
+                                    own,
                                     &mut stencil,
                                 )
                                 .map_err(|e| (point, e))?;

@@ -22,6 +22,11 @@ pub trait ExplicitMesh<const D: usize>: Send + Sync {
     /// The regular lattice of the nodes (the gap check of the friction
     /// walls finds the nodes under a point from it).
     fn lattice(&self) -> Lattice<D>;
+    /// The volume of a cell (area in 2D; the contact's full node,
+    /// [`super::contact`]): $h^D$ unless the mesh says otherwise.
+    fn cell_volume(&self) -> f64 {
+        self.min_spacing().powi(D as i32)
+    }
 }
 
 impl<const D: usize> ExplicitMesh<D> for RegularGrid<D> {
@@ -60,5 +65,9 @@ impl<const D: usize> ExplicitMesh<D> for RegularGrid<D> {
             spacing: *self.spacing(),
             nodes: self.nodes_per_axis(),
         }
+    }
+
+    fn cell_volume(&self) -> f64 {
+        self.spacing().product()
     }
 }

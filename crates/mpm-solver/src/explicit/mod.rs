@@ -29,6 +29,7 @@
 //! parts of the grid, so the buffers cost little more than one grid.
 
 pub mod absorbing;
+pub mod contact;
 pub mod dilatation;
 pub mod energy;
 pub mod fixities;
@@ -52,6 +53,7 @@ use mpm_constitutive::IncrementalLaw;
 use nalgebra::{SMatrix, SVector};
 
 pub use absorbing::Dashpot;
+pub use contact::Contact;
 pub use dilatation::{CellAveraged, DilatationTreatment};
 pub use energy::Energies;
 pub use fixities::{FrictionWall, VelocityFixities};
@@ -226,6 +228,9 @@ where
     position_scratch: Vec<SVector<f64, D>>,
     /// The other ranks, in a distributed run.
     on_ranks: Option<OnRanks>,
+    /// The velocity fields of a run with contact between bodies (`None`:
+    /// one field, the stages as without contact).
+    contact: Option<Contact<D>>,
 }
 
 impl<const D: usize, B, L, T, K> ExplicitSolver<D, B, L, T, K>
@@ -331,6 +336,7 @@ where
             domain_rule: NoUpdate,
             position_scratch: Vec::new(),
             on_ranks: None,
+            contact: None,
         })
     }
 }
@@ -382,7 +388,39 @@ where
             domain_rule: rule,
             position_scratch: self.position_scratch,
             on_ranks: self.on_ranks,
+            contact: self.contact,
         }
+    }
+
+    /// The same solver with multi-field contact between bodies
+    /// ([`contact`]): `friction[k]` is the Coulomb coefficient of velocity
+    /// field `k` (at a node the largest of the fields present applies),
+    /// and every point's field is `points.field[p]` (one entry per
+    /// point, below `friction.len()`).
+    ///
+    /// # Errors
+    /// As [`Contact::new`]; absorbing boundaries (their springs hold one
+    /// state per node, not per field) or a run on several ranks (not yet
+    /// supported).
+    pub fn with_contact(mut self, friction: Vec<f64>) -> Result<Self, SolverError> {
+        if !self.fixities.dashpots().is_empty() {
+            return Err(SolverError::InvalidInput(
+                "contact between bodies is not supported with absorbing boundaries".into(),
+            ));
+        }
+        if self.on_ranks.is_some() {
+            return Err(SolverError::InvalidInput(
+                "contact between bodies is not yet supported on several ranks".into(),
+            ));
+        }
+        let cell = self.mesh.cell_volume();
+        self.contact = Some(Contact::new(friction, self.node_count, cell)?);
+        Ok(self)
+    }
+
+    /// The contact between bodies, if the run has one.
+    pub fn contact(&self) -> Option<&Contact<D>> {
+        self.contact.as_ref()
     }
 
     /// The domain update.
@@ -617,6 +655,9 @@ where
                 points.id.len()
             )));
         }
+        if let Some(c) = &self.contact {
+            check_fields(c.fields(), points)?;
+        }
         Ok(dt)
     }
 
@@ -639,6 +680,14 @@ where
         points: &PointsOf<D, B, L, T>,
         dt: f64,
     ) -> Result<WallWork, (usize, PointFailure)> {
+        if let Some(contact) = &mut self.contact {
+            return Ok(contact::update_fields(
+                contact,
+                &mut self.grid,
+                dt,
+                &self.fixities,
+            ));
+        }
         let owner = self.on_ranks.as_ref().map(OnRanks::owner_of_node);
         self.touch.mark(&points.position, &points.volume);
         let work = grid_update::update(
@@ -785,6 +834,9 @@ where
         &mut self,
         points: &PointsOf<D, B, L, T>,
     ) -> Result<(), (usize, PointFailure)> {
+        if self.contact.is_some() {
+            return self.point_to_fields(points);
+        }
         let threads = rayon::current_num_threads().max(1);
         self.buffers
             .resize_with(threads, || GridBuffer::new(self.node_count));
@@ -845,4 +897,107 @@ where
         }
         Ok(())
     }
+
+    /// Point to grid with contact: [`contact::scatter_fields`] over the
+    /// threads' field buffers, then the applied point forces.
+    fn point_to_fields(
+        &mut self,
+        points: &PointsOf<D, B, L, T>,
+    ) -> Result<(), (usize, PointFailure)> {
+        let Some(contact) = &mut self.contact else {
+            return Ok(());
+        };
+        let threads = rayon::current_num_threads().max(1);
+        let fields = contact.fields();
+        contact.buffers.resize_with(threads, || {
+            contact::FieldBuffer::new(self.node_count, fields)
+        });
+        let n = points.len();
+        let per = n.div_ceil(threads).max(1);
+        let view = p2g::PointsView {
+            position: &points.position,
+            velocity: &points.velocity,
+            mass: &points.mass,
+            volume0: &points.volume0,
+            tau: &points.tau,
+            transfer: &points.transfer,
+            domain: &points.domain,
+        };
+        let (basis, mesh, gravity, node_position) = (
+            &self.basis,
+            &self.mesh,
+            &self.options.gravity,
+            &self.node_position,
+        );
+        let field = &points.field[..];
+        par::reduce(
+            &mut contact.buffers[..],
+            1,
+            &|first, buffers| {
+                let mut stencil = basis.new_stencil();
+                let mut result = Ok(0.0);
+                for (j, buffer) in buffers.iter_mut().enumerate() {
+                    let k = first + j;
+                    buffer.clear();
+                    let range = (k * per).min(n)..((k + 1) * per).min(n);
+                    let scattered = contact::scatter_fields::<D, B, T>(
+                        basis,
+                        mesh,
+                        &view,
+                        (field, &points.volume),
+                        node_position,
+                        gravity,
+                        range,
+                        buffer,
+                        &mut stencil,
+                    );
+                    result = gather::worse(result, scattered.map(|()| 0.0));
+                }
+                result
+            },
+            gather::worse,
+        )?;
+        if !points.point_force.is_empty() {
+            let mut stencil = self.basis.new_stencil();
+            contact::scatter_field_forces(
+                &self.basis,
+                &self.mesh,
+                &points.position,
+                &points.domain,
+                field,
+                &points.point_force,
+                &mut contact.buffers[0],
+                &mut stencil,
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// The points of a run with `fields` velocity fields: one field each,
+/// below `fields`, and no material-point fixity (held on one field's grid
+/// only, it would not hold).
+fn check_fields<const D: usize, S, T, Dom>(
+    fields: usize,
+    points: &ExplicitPoints<D, S, T, Dom>,
+) -> Result<(), SolverError> {
+    if points.field.len() != points.len() {
+        return Err(SolverError::InvalidInput(format!(
+            "contact between bodies needs a velocity field per point: {} points, {} fields given",
+            points.len(),
+            points.field.len()
+        )));
+    }
+    if let Some(p) = points.field.iter().position(|&k| usize::from(k) >= fields) {
+        return Err(SolverError::InvalidInput(format!(
+            "point {p} is in velocity field {}; the contact has {fields}",
+            points.field[p]
+        )));
+    }
+    if !points.fixed_velocity.is_empty() {
+        return Err(SolverError::InvalidInput(
+            "contact between bodies is not supported with material-point fixities".into(),
+        ));
+    }
+    Ok(())
 }

@@ -72,6 +72,11 @@ where
                 "gap-checked friction walls (`gap_check = true`) run on one process only".into(),
             ));
         }
+        if self.contact.is_some() {
+            return Err(SolverError::InvalidInput(
+                "contact between bodies is not yet supported on several ranks".into(),
+            ));
+        }
         layout.check(
             ranks.rank(),
             ranks.size(),

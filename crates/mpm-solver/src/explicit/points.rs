@@ -50,6 +50,10 @@ pub struct ExplicitPoints<const D: usize, S, T, Dom = ()> {
     pub domain: Vec<Dom>,
     /// The domains at the start (what rules such as eq. 34 scale).
     pub domain0: Vec<Dom>,
+    /// The velocity field of each point in a run with contact between
+    /// bodies ([`super::contact`], one entry per point); empty without
+    /// contact: every point then belongs to the grid's one field.
+    pub field: Vec<u8>,
 }
 
 impl<const D: usize, S, T, Dom> ExplicitPoints<D, S, T, Dom> {
@@ -115,6 +119,9 @@ impl<const D: usize, S, T, Dom> ExplicitPoints<D, S, T, Dom> {
         pick(&mut self.transfer, ids);
         pick(&mut self.domain, ids);
         pick(&mut self.domain0, ids);
+        if !self.field.is_empty() {
+            pick(&mut self.field, ids);
+        }
         let at = |p: usize| slot_of.get(p).copied().filter(|&k| k != usize::MAX);
         self.point_force = (self.point_force.iter())
             .filter_map(|&(p, f)| at(p).map(|k| (k, f)))
@@ -159,6 +166,7 @@ impl<const D: usize, S: Copy + Default, T: Copy + Default> ExplicitPoints<D, S, 
             fixed_velocity: self.fixed_velocity,
             domain0: domains.clone(),
             domain: domains,
+            field: self.field,
         })
     }
 
@@ -200,6 +208,7 @@ impl<const D: usize, S: Copy + Default, T: Copy + Default> ExplicitPoints<D, S, 
             fixed_velocity: Vec::new(),
             domain: vec![(); n],
             domain0: vec![(); n],
+            field: Vec::new(),
             position,
         })
     }
