@@ -305,13 +305,15 @@ pub fn scatter_field_forces<const D: usize, B: BasisFunction<D>>(
 /// give its velocities (eqs. 30–32) in `contact`'s grids and their sum the
 /// centre-of-mass velocities in `grid`; the fields meet at the nodes two
 /// or more of them reach ([`correct_node`]); then the nodal fixities and
-/// the friction walls act on every field (and the fixities on `grid`).
+/// the friction walls act on every field (and the fixities on `grid`),
+/// the gap-checked ones where `touched` (by any body's points).
 /// Returns what the contact and the walls took.
 pub fn update_fields<const D: usize>(
     contact: &mut Contact<D>,
     grid: &mut GridState<D>,
     dt: f64,
     fixities: &VelocityFixities,
+    touched: &[bool],
 ) -> WallWork {
     let buffers = &contact.buffers;
     let lo = buffers.iter().map(|b| b.lo).min().unwrap_or(usize::MAX);
@@ -369,7 +371,7 @@ pub fn update_fields<const D: usize>(
                 g.velocity[node].new[component] = value;
             }
         }
-        work = work.plus(friction_walls(g, fixities.walls(), |_| true));
+        work = work.plus(friction_walls(g, fixities.walls(), touched, |_| true));
     }
     work
 }
@@ -584,7 +586,7 @@ mod tests {
             let mut grid = GridState::<2>::new(1);
             let mut fixities = VelocityFixities::new();
             fixities.finish();
-            let work = update_fields(&mut contact, &mut grid, 0.1, &fixities);
+            let work = update_fields(&mut contact, &mut grid, 0.1, &fixities, &[]);
             let (a, b) = (
                 contact.grids[0].velocity[0].new,
                 contact.grids[1].velocity[0].new,

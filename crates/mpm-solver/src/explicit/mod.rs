@@ -680,16 +680,17 @@ where
         points: &PointsOf<D, B, L, T>,
         dt: f64,
     ) -> Result<WallWork, (usize, PointFailure)> {
+        self.touch.mark(&points.position, &points.volume);
         if let Some(contact) = &mut self.contact {
             return Ok(contact::update_fields(
                 contact,
                 &mut self.grid,
                 dt,
                 &self.fixities,
+                self.touch.touched(),
             ));
         }
         let owner = self.on_ranks.as_ref().map(OnRanks::owner_of_node);
-        self.touch.mark(&points.position, &points.volume);
         let work = grid_update::update(
             &self.buffers,
             &mut self.grid,
