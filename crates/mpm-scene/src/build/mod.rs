@@ -667,6 +667,7 @@ impl<const D: usize> Problem<D> {
             initial_stress::initial_state_of_points(&scene.bodies, &bodies, &materials, src)?;
         let sets = node_sets::node_sets(&scene.node_sets, &mesh, &bodies, src)?;
         let conditions = conditions::conditions(scene, &mesh, &sets, &curves, explicit, src)?;
+        conditions::refuse_unreachable_gap_checks(scene, variant.basis, src)?;
         let absorbing = absorbing::absorbing_faces(
             scene,
             &mesh,

@@ -680,7 +680,8 @@ where
         points: &PointsOf<D, B, L, T>,
         dt: f64,
     ) -> Result<WallWork, (usize, PointFailure)> {
-        self.touch.mark(&points.position, &points.volume);
+        self.touch
+            .mark(&points.position, &points.velocity, &points.volume, dt);
         if let Some(contact) = &mut self.contact {
             return Ok(contact::update_fields(
                 contact,
