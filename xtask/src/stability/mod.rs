@@ -11,6 +11,7 @@
 //! fails on a panic, a non-finite number anywhere in a row, or an outcome
 //! other than the expected one.
 
+mod contact;
 mod extreme;
 mod rotation;
 mod scenarios;
@@ -458,7 +459,7 @@ pub fn matrix(mode: Mode) -> Vec<Row> {
 
 /// What builds each family's rows, in page order (the families are
 /// independent: the test runs them side by side).
-const FAMILY_RUNS: [fn(Mode) -> Vec<Row>; 9] = [
+const FAMILY_RUNS: [fn(Mode) -> Vec<Row>; 10] = [
     scenarios::locking,
     scenarios::contrast,
     scenarios::step_size,
@@ -467,11 +468,12 @@ const FAMILY_RUNS: [fn(Mode) -> Vec<Row>; 9] = [
     soil::rows,
     scenarios::failures,
     scenarios::explicit,
+    contact::rows,
     |_| scenarios::meshes(),
 ];
 
 /// The families in page order, with their introductions.
-const FAMILIES: [(&str, &str); 9] = [
+const FAMILIES: [(&str, &str); 10] = [
     (
         "locking",
         "ν ∈ {0.3, 0.49, 0.4999} × locking treatment × formulation on the cases with references: the column (eq. 42 error against σ_zz = −ϱ₀g(l₀ − Z), which holds for any ν in uniaxial strain), Cook's membrane (small load, linear response; the tip displacement scaled to a load of 100) and the Prandtl footing (error = plateau pressure / ((2 + π)k) − 1). Cook's membrane and the footing run the previously converged formulation (`mpm_cases::locking`).",
@@ -503,6 +505,10 @@ const FAMILIES: [(&str, &str); 9] = [
     (
         "explicit",
         "The explicit solver: a fixed Δt at 1.5× and 3× the CFL limit (refused before the step, with the Courant number), a very soft / very stiff pair (E = 10³ and 10⁹ Pa: a stiffness contrast of 10⁶, each point stepping with its own wave speed) and a light / heavy pair (densities 10³ and 10⁻³: the same wave-speed contrast, one law), high-speed impacts (on a fixed wall, on a friction wall that lets the block go and books the friction and impact losses in the energy total, and on an absorbing wall whose dashpots slow the block but do not stop it).",
+    ),
+    (
+        "contact",
+        "Contact (issue 44): soft blocks at ±40 m/s meeting by multi-field contact, alike and against a block 10⁵ times stiffer (the energy drift with the contact's friction and impact losses booked), a block into a friction wall with and without the gap check on the boundary-modified B-splines (at ten times the wave speed a corner point crosses the wall and the run stops with a typed error: the trapezoidal position update moves a point by half its approach in the step the wall stops its nodes), and the refusal of a gap check with the B-splines that keep points a cell inside the grid (a block went through it before the refusal); the implicit solver's rigid platen of `scenes/platen_cube.toml` (error: the platen's force against E ln 0.99 on the unit face) with its penalty 10⁻³ and 10⁴ times the default, partial slip (a non-symmetric tangent, LU) and the whole stroke in one step.",
     ),
     (
         "mesh",
