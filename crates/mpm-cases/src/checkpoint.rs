@@ -60,6 +60,10 @@ pub struct Header {
     pub predictor_load_increment: f64,
     /// The case's accumulators ([`Checkpoint::case_state`]).
     pub case_state: Vec<f64>,
+    /// The rigid tools' contact forces ([`Checkpoint::contact`]; absent,
+    /// and empty, without tools).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contact: Vec<f64>,
     /// The output written so far.
     pub writer: WriterState,
 }
@@ -85,6 +89,7 @@ pub fn write(
         .iter()
         .chain(predictor)
         .chain(&checkpoint.case_state)
+        .chain(&checkpoint.contact)
         .find(|x| !x.is_finite())
     {
         return Err(OutputError::NonFiniteField {
@@ -107,6 +112,7 @@ pub fn write(
         predictor_len: predictor.len(),
         predictor_load_increment,
         case_state: checkpoint.case_state.clone(),
+        contact: checkpoint.contact.clone(),
         writer,
     };
     let json = serde_json::to_string(&header).map_err(|e| CasesError::Io {
@@ -176,6 +182,7 @@ pub fn read(dir: &Path) -> Result<(Header, Checkpoint), CasesError> {
         points: points.to_vec(),
         wall_time_s: header.wall_time_s,
         case_state: header.case_state.clone(),
+        contact: header.contact.clone(),
     };
     Ok((header, checkpoint))
 }

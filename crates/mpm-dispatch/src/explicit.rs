@@ -1119,6 +1119,7 @@ fn snapshot<const D: usize>(
                 },
             },
             predictor: None,
+            contact: Vec::new(),
             points,
             wall_time_s,
             case_state,

@@ -83,6 +83,9 @@ pub struct Checkpoint {
     /// The Newton predictor's memory (increment per mesh dof, load
     /// increment).
     pub predictor: Option<(Vec<f64>, f64)>,
+    /// The rigid tools' committed contact forces
+    /// ([`ImplicitSolver::contact_state`]; empty without tools).
+    pub contact: Vec<f64>,
     /// The material points ([`MaterialPoints::to_flat`]).
     pub points: Vec<f64>,
     /// Solver wall time so far (s).
@@ -331,14 +334,9 @@ where
     // ranks: restored whole, then dealt as at the start.
     let (state, earlier_time) = match &control.resume {
         Some(c) => {
-            if let Some(tool) = solver.constraints.tools().first() {
-                return Err(SolverError::Contact {
-                    tool: tool.name.clone(),
-                    reason: "a checkpoint does not hold the tools' contact forces: a run with a rigid tool (kind = contact) cannot be resumed; run it again from the start",
-                });
-            }
             resume_points(c, &mut points)?;
             solver.set_predictor_state(c.predictor.clone())?;
+            solver.set_contact_state(&c.contact)?;
             (c.state, c.wall_time_s)
         }
         None => (RunState::start(&setup.stepping), 0.0),
@@ -380,6 +378,7 @@ where
                 snapshot.checkpoint = Some(Checkpoint {
                     state: now.state,
                     predictor: now.predictor.map(|(u, dl)| (u.to_vec(), dl)),
+                    contact: now.contact.to_vec(),
                     points,
                     wall_time_s: earlier_time + start.elapsed().as_secs_f64() - observer_time,
                     case_state: Vec::new(),

@@ -70,6 +70,8 @@ pub struct StepContext<'a, M> {
     pub state: RunState,
     /// [`ImplicitSolver::predictor_state`] after the step.
     pub predictor: Option<(&'a [f64], f64)>,
+    /// [`ImplicitSolver::contact_state`] after the step.
+    pub contact: &'a [f64],
     /// The background mesh the step was solved on (it moves with
     /// moving-mesh conditions).
     pub mesh: &'a M,
@@ -132,6 +134,7 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
                     let context = StepContext {
                         state: control.state(),
                         predictor: self.predictor_state(),
+                        contact: self.contact_state(),
                         mesh: &self.mesh,
                         stiffness: self.free_stiffness(),
                     };

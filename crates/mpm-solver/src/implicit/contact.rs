@@ -39,6 +39,9 @@ struct Entry<const D: usize> {
 pub(super) struct ContactState<const D: usize> {
     /// Per tool, the committed force of each of its nodes.
     committed: Vec<Vec<ContactForce<D>>>,
+    /// `committed` flat, per tool and node $(f_n, \mathbf t)$: $D + 1$
+    /// numbers per node ([`ImplicitSolver::contact_state`]).
+    flat: Vec<f64>,
     /// The nodes in contact this step.
     entries: Vec<Entry<D>>,
     /// Per entry, the response at the current increment.
@@ -232,6 +235,59 @@ impl<const D: usize, P: SolverParts<D>> ImplicitSolver<D, P> {
         for (e, r) in state.entries.iter().zip(&state.trial) {
             state.committed[e.tool][e.index] = r.force;
         }
+        state.flat.clear();
+        for f in state.committed.iter().flatten() {
+            state.flat.push(f.normal);
+            state.flat.extend(f.tangential.iter());
+        }
+    }
+
+    /// The tools' committed contact forces, per tool and node $(f_n,
+    /// \mathbf t)$, for a checkpoint; empty before the first converged
+    /// step or without tools.
+    pub fn contact_state(&self) -> &[f64] {
+        &self.contact.flat
+    }
+
+    /// Restores [`Self::contact_state`] (the forces each tool's nodes carry
+    /// into the next step).
+    ///
+    /// # Errors
+    /// [`SolverError::InvalidInput`] if `flat` does not hold $D + 1$
+    /// finite numbers per node of every tool (none without tools), or a
+    /// normal force is negative.
+    pub fn set_contact_state(&mut self, flat: &[f64]) -> Result<(), SolverError> {
+        let sizes: Vec<usize> = self
+            .constraints
+            .tools()
+            .iter()
+            .map(|t| t.nodes.len())
+            .collect();
+        let expected = (D + 1) * sizes.iter().sum::<usize>();
+        let valid = flat.chunks(D + 1).all(|f| f[0] >= 0.0) && flat.iter().all(|x| x.is_finite());
+        if !flat.is_empty() && (flat.len() != expected || !valid) {
+            return Err(SolverError::InvalidInput(format!(
+                "the checkpoint's contact state has {} numbers, not the {expected} finite ones (normal force ≥ 0) of the scene's tools",
+                flat.len()
+            )));
+        }
+        let mut numbers = flat.chunks(D + 1);
+        let state = &mut self.contact;
+        state.committed = (sizes.iter())
+            .map(|&n| {
+                (0..n)
+                    .map(|_| match numbers.next() {
+                        Some(f) => ContactForce {
+                            normal: f[0],
+                            tangential: SVector::from_fn(|i, _| f[1 + i]),
+                        },
+                        None => ContactForce::default(),
+                    })
+                    .collect()
+            })
+            .collect();
+        state.flat = flat.to_vec();
+        Ok(())
     }
 }
 
