@@ -241,16 +241,13 @@ where
             node_count,
             stencil,
             |i, w, g| {
-                let wm = w * m;
                 let carried = if T::TAYLOR {
                     T::nodal_velocity(v, state, &(node_position[i] - x))
                 } else {
                     *v
                 };
                 let node = &mut sums[i * fields + k];
-                node.sums.mass += wm;
-                node.sums.momentum += carried * wm;
-                node.sums.force += body * w - stress * g;
+                node.sums.add_point((w, g), m, &carried, &body, &stress);
                 node.mass_gradient += g * m;
                 node.volume += w * vol;
                 lo = lo.min(i);

@@ -20,6 +20,26 @@ pub struct NodeSums<const D: usize> {
 }
 
 impl<const D: usize> NodeSums<D> {
+    /// Adds one point's share at a node of weight `w` and gradient `g`
+    /// (eqs. 20–22, 28–29): mass $w m_p$, momentum $w m_p$ times the
+    /// velocity the point carries to the node, force $w\,m_p\mathbf g -
+    /// V^0_p\tau_p\nabla w$ (`body` $= m_p\mathbf g$, `stress` $=
+    /// V^0_p\tau_p$).
+    #[inline(always)]
+    pub fn add_point(
+        &mut self,
+        (w, g): (f64, &SVector<f64, D>),
+        mass: f64,
+        carried: &SVector<f64, D>,
+        body: &SVector<f64, D>,
+        stress: &SMatrix<f64, D, D>,
+    ) {
+        let wm = w * mass;
+        self.mass += wm;
+        self.momentum += carried * wm;
+        self.force += body * w - stress * g;
+    }
+
     /// Nothing.
     pub const ZERO: Self = Self {
         mass: 0.0,

@@ -136,16 +136,12 @@ where
             }
         }
         visit_nodes(basis, mesh, x, domain, node_count, stencil, |i, w, g| {
-            let wm = w * m;
             let carried = if T::TAYLOR {
                 T::nodal_velocity(v, state, &(node_position[i] - x))
             } else {
                 *v
             };
-            let node = &mut nodes[i];
-            node.mass += wm;
-            node.momentum += carried * wm;
-            node.force += body * w - stress * g;
+            nodes[i].add_point((w, g), m, &carried, &body, &stress);
             lo = lo.min(i);
             hi = hi.max(i + 1);
         })
